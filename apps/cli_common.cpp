@@ -1,0 +1,60 @@
+#include "apps/cli_common.h"
+
+#include <fmt/core.h>
+
+#include "apps/progress.h"
+#include "geometry/default_scene.h"
+
+namespace bsprt::cli {
+
+void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& default_accel) {
+  o.accel = default_accel;
+  std::string names;
+  for (const std::string& n : accel_names()) names += (names.empty() ? "" : "|") + n;
+  cmd.add_option("--accel", o.accel, "accelerator: " + names)->capture_default_str();
+  cmd.add_option("--tree", o.tree, "tree file written by `bsprt build` (kd, bsp); built in memory if absent");
+  cmd.add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd.add_option("--packets", o.packets, "rays per packet: 1 (single rays), 4, 8 or 16")
+      ->check(CLI::IsMember({1, 4, 8, 16}))
+      ->capture_default_str();
+  cmd.add_flag("--allow-nonfinite", o.allow_nonfinite,
+               "keep triangles with NaN/Inf corners (flagged degenerate, never hit) instead of failing");
+}
+
+TriangleSoup load_scene(const std::string& path, bool allow_nonfinite, bool verbose) {
+  if (path.empty() || path == "default") {
+    TriangleSoup soup = make_default_scene();
+    if (verbose)
+      fmt::print(stderr, "scene: embedded default scene, {} triangles, {} vertices\n", soup.size(),
+                 soup.vertices.size());
+    return soup;
+  }
+  LoadOptions options;
+  options.allow_nonfinite = allow_nonfinite;
+  LoadReport report;
+  TriangleSoup soup = load_mesh(path, options, &report);
+  if (verbose)
+    fmt::print(stderr, "scene: {} ({}): {} triangles from {} faces, {} vertices ({} unreferenced), {} degenerate{}, loaded in {:.3f} s\n",
+               path, report.format, report.triangles, report.faces, report.vertices,
+               report.unreferenced_vertices, report.degenerate,
+               report.nonfinite_triangles ? fmt::format(" ({} with non-finite corners)", report.nonfinite_triangles)
+                                          : std::string(),
+               report.seconds);
+  return soup;
+}
+
+std::unique_ptr<tbb::global_control> limit_threads(int threads) {
+  if (threads <= 0) return nullptr;
+  return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                               std::size_t(threads));
+}
+
+std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& soup) {
+  AccelOptions options;
+  options.tree_path = o.tree;
+  options.threads = o.threads;
+  options.progress = ProgressBar::stderr_is_terminal();
+  return make_tracer(o.accel, soup, options);
+}
+
+}  // namespace bsprt::cli

@@ -1,0 +1,46 @@
+#pragma once
+/// \file cli_common.h
+/// What the `bsprt` subcommands share: loading a scene (or the embedded default
+/// one), the --accel/--tree/--threads options, a TBB thread cap.
+
+#include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
+
+#include <memory>
+#include <string>
+
+#include "builder/accel_factory.h"
+#include "geometry/load_mesh.h"
+#include "geometry/triangle_soup.h"
+
+namespace bsprt::cli {
+
+/// Options every tracing subcommand takes.
+struct TraceOptions {
+  std::string accel = "embree";
+  std::string tree;
+  int threads = 0;
+  int packets = 1;
+  bool allow_nonfinite = false;
+};
+
+/// Adds --accel, --tree, --threads, --packets, --allow-nonfinite to `cmd`.
+void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& default_accel);
+
+/// Loads SCENE, or the embedded default scene when `path` is empty or
+/// "default"; prints a one-line load summary to stderr when `verbose`.
+TriangleSoup load_scene(const std::string& path, bool allow_nonfinite, bool verbose);
+
+/// Caps TBB's worker threads for the life of the returned object (0 = all cores).
+std::unique_ptr<tbb::global_control> limit_threads(int threads);
+
+/// Builds or loads the accelerator named in `o`, with a progress bar on a terminal.
+std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& soup);
+
+/// Registration of each subcommand (one file each).
+void register_trace(CLI::App& app);
+void register_render(CLI::App& app);
+void register_info(CLI::App& app);
+void register_gen_rays(CLI::App& app);
+
+}  // namespace bsprt::cli

@@ -1,0 +1,90 @@
+// `bsprt trace SCENE RAYS -o HITS`: traces a ray file with any accelerator and
+// writes the nearest hits, reporting rays, hits, seconds and Mrays/s.
+#include <fmt/core.h>
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <memory>
+
+#include "apps/cli_common.h"
+#include "apps/progress.h"
+#include "geometry/ray_io.h"
+
+namespace bsprt::cli {
+namespace {
+
+struct TraceArgs {
+  std::string scene, rays, hits;
+  TraceOptions trace;
+  bool json = false;
+  bool stats = false;
+};
+
+/// Traces all rays in parallel blocks; returns the summed counters.
+RayCounters trace_all(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits,
+                      int packets, bool count) {
+  tbb::combinable<RayCounters> counters;
+  ProgressBar bar("tracing", rays.size(), "rays", ProgressBar::stderr_is_terminal() && rays.size() > (1u << 20));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 4096), [&](const auto& r) {
+    std::span<const Ray> in(rays.data() + r.begin(), r.size());
+    std::span<Hit> out(hits.data() + r.begin(), r.size());
+    tracer.trace_batch(in, out, packets, count ? &counters.local() : nullptr);
+    bar.advance(r.size());
+  });
+  bar.finish();
+  return counters.combine([](RayCounters a, const RayCounters& b) { return a += b; });
+}
+
+void run(const TraceArgs& a) {
+  const auto threads = limit_threads(a.trace.threads);
+  const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, !a.json);
+  const std::vector<Ray> rays = read_rays(a.rays);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::unique_ptr<Tracer> tracer = make_accel(a.trace, soup);
+  const auto t1 = std::chrono::steady_clock::now();
+  std::vector<Hit> hits(rays.size());
+  const RayCounters c = trace_all(*tracer, rays, hits, a.trace.packets, a.stats);
+  const auto t2 = std::chrono::steady_clock::now();
+  write_hits(a.hits, hits);
+
+  std::size_t nhit = 0;
+  for (const Hit& h : hits) nhit += h.hit();
+  const double build_s = std::chrono::duration<double>(t1 - t0).count();
+  const double trace_s = std::chrono::duration<double>(t2 - t1).count();
+  const double mrays = trace_s > 0 ? double(rays.size()) / trace_s * 1e-6 : 0.0;
+  const double n = rays.empty() ? 1.0 : double(rays.size());
+  if (a.json) {
+    fmt::print("{{\"accel\": \"{}\", \"rays\": {}, \"hits\": {}, \"build_seconds\": {:.6f}, "
+               "\"trace_seconds\": {:.6f}, \"mrays_per_second\": {:.4f}, \"packets\": {}",
+               tracer->name(), rays.size(), nhit, build_s, trace_s, mrays, a.trace.packets);
+    if (a.stats)
+      fmt::print(", \"per_ray\": {{\"kd_node_visits\": {:.4f}, \"bsp_node_visits\": {:.4f}, "
+                 "\"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}}}",
+                 c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n);
+    fmt::print("}}\n");
+    return;
+  }
+  fmt::print("accel {}: {} rays, {} hits, build {:.3f} s, trace {:.3f} s, {:.2f} Mrays/s\n", tracer->name(),
+             rays.size(), nhit, build_s, trace_s, mrays);
+  if (a.stats)
+    fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests\n",
+               c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n);
+}
+
+}  // namespace
+
+void register_trace(CLI::App& app) {
+  auto args = std::make_shared<TraceArgs>();
+  CLI::App* cmd = app.add_subcommand("trace", "trace a .rays file and write the nearest hits to a .hits file");
+  cmd->add_option("SCENE", args->scene, "mesh file (obj, ply, off, stl) or 'default'")->required();
+  cmd->add_option("RAYS", args->rays, ".rays file (see `bsprt gen-rays`)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->hits, ".hits file to write")->required();
+  add_trace_options(*cmd, args->trace, "embree");
+  cmd->add_flag("--json", args->json, "print one JSON object instead of text");
+  cmd->add_flag("--stats", args->stats, "count and print node visits and triangle tests per ray");
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace bsprt::cli

@@ -1,0 +1,40 @@
+#pragma once
+/// \file error.h
+/// Typed errors for bad input. Library code never exits or prints: it throws one
+/// of these with the file, the line or element, and what was expected; the CLI
+/// turns it into a message and a non-zero exit.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace bsprt {
+
+/// Malformed or unusable input file (mesh, rays, hits, tree). `what()` reads
+/// "FILE:LINE: message" (or "FILE: message" when no line applies).
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string file, std::int64_t line, const std::string& message)
+      : std::runtime_error(format(file, line, message)), file_(std::move(file)), line_(line) {}
+  InputError(std::string file, const std::string& message) : InputError(std::move(file), -1, message) {}
+
+  /// The offending file.
+  const std::string& file() const { return file_; }
+  /// 1-based line (text formats) or -1 when no line applies.
+  std::int64_t line() const { return line_; }
+
+ private:
+  static std::string format(const std::string& file, std::int64_t line, const std::string& msg) {
+    return line >= 0 ? file + ":" + std::to_string(line) + ": " + msg : file + ": " + msg;
+  }
+  std::string file_;
+  std::int64_t line_;
+};
+
+/// A violated precondition on arguments passed by a caller (not a file).
+class UsageError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+}  // namespace bsprt

@@ -1,0 +1,118 @@
+/// \file exact_eval.cpp
+/// The exact stage of the side tests (exact_side.h): plane coefficients and
+/// triple-plane intersections evaluated with CGAL::Mpzf, which adds and
+/// multiplies doubles exactly. Every value is a polynomial in the input floats
+/// (no division: the intersection point N/D is tested as sign(n·N + d·D)·sign(D)).
+#include <CGAL/FPU.h>
+#include <CGAL/Interval_nt.h>
+#include <CGAL/Mpzf.h>
+
+#include <cmath>
+
+#include "geometry/check.h"
+#include "robust/exact_side.h"
+
+namespace bsprt {
+
+namespace {
+
+using NT = CGAL::Mpzf;
+using V3 = std::array<NT, 3>;
+
+V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V3 cross3(const V3& a, const V3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+NT dot3(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+V3 scale(const NT& s, const V3& a) { return {s * a[0], s * a[1], s * a[2]}; }
+V3 to_v3(const Vec3f& p) { return {NT(double(p.x)), NT(double(p.y)), NT(double(p.z))}; }
+
+/// Exact normal n and offset d (value = n·p + d) of a stored plane.
+struct ExactPlane {
+  V3 n;
+  NT d;
+};
+
+ExactPlane exact_plane(const TriangleSoup& soup, PlaneDef p) {
+  ExactPlane e{{NT(0.0), NT(0.0), NT(0.0)}, NT(-double(p.coord()))};
+  if (p.is_kd()) {
+    e.n[p.axis()] = NT(1.0);
+    return e;
+  }
+  const std::uint32_t t = p.tri();
+  const V3 p0 = to_v3(soup.corner(t, 0)), p1 = to_v3(soup.corner(t, 1)), p2 = to_v3(soup.corner(t, 2));
+  V3 n = cross3(sub(p1, p0), sub(p2, p0));
+  V3 r = p0;
+  if (p.kind == PlaneKind::Edge) {
+    const int k = p.edge_index();
+    const V3 a0 = to_v3(soup.corner(t, k)), a1 = to_v3(soup.corner(t, (k + 1) % 3));
+    n = cross3(n, sub(a1, a0));
+    r = a0;
+  }
+  e.d = -dot3(n, r);
+  e.n = n;
+  return e;
+}
+
+/// Homogeneous intersection (N, D) of three planes: the point is N / D.
+struct Homogeneous {
+  V3 num;
+  NT den;
+};
+
+Homogeneous intersect(const TriangleSoup& soup, const std::array<PlaneDef, 3>& def) {
+  const ExactPlane a = exact_plane(soup, def[0]), b = exact_plane(soup, def[1]),
+                   c = exact_plane(soup, def[2]);
+  const V3 bc = cross3(b.n, c.n), ca = cross3(c.n, a.n), ab = cross3(a.n, b.n);
+  Homogeneous h;
+  h.den = dot3(a.n, bc);
+  BSPRT_CHECK(!h.den.is_zero());  // three stored planes that do not meet in a point
+  const V3 s1 = scale(a.d, bc), s2 = scale(b.d, ca), s3 = scale(c.d, ab);
+  for (int i = 0; i < 3; ++i) h.num[i] = -(s1[i] + s2[i] + s3[i]);
+  return h;
+}
+
+int sign_of(const NT& x) { return x.is_zero() ? 0 : (x.sign() > 0 ? 1 : -1); }
+
+}  // namespace
+
+int exact_side_at(const TriangleSoup& soup, PlaneDef plane, const std::array<double, 3>& p) {
+  const ExactPlane e = exact_plane(soup, plane);
+  const NT v = e.n[0] * NT(p[0]) + e.n[1] * NT(p[1]) + e.n[2] * NT(p[2]) + e.d;
+  return sign_of(v);
+}
+
+int exact_side_at(const TriangleSoup& soup, PlaneDef plane, const std::array<PlaneDef, 3>& def) {
+  const Homogeneous h = intersect(soup, def);
+  const ExactPlane e = exact_plane(soup, plane);
+  const NT v = dot3(e.n, h.num) + e.d * h.den;
+  return sign_of(v) * sign_of(h.den);
+}
+
+IntervalBox exact_enclosure(const TriangleSoup& soup, const std::array<PlaneDef, 3>& def) {
+  const Homogeneous h = intersect(soup, def);
+  using IA = CGAL::Interval_nt<true>;  // self-protecting: callable in any rounding mode
+  const IA den(h.den.to_interval());
+  IntervalBox box;
+  for (int i = 0; i < 3; ++i) {
+    const IA x = IA(h.num[i].to_interval()) / den;
+    box.lo[i] = x.inf();
+    box.hi[i] = x.sup();
+  }
+  return box;
+}
+
+bool triangle_degenerate_exact(const TriangleSoup& soup, std::uint32_t t) {
+  for (int k = 0; k < 3; ++k)
+    if (!is_finite(soup.corner(t, k))) return true;
+  const V3 p0 = to_v3(soup.corner(t, 0)), p1 = to_v3(soup.corner(t, 1)), p2 = to_v3(soup.corner(t, 2));
+  const V3 n = cross3(sub(p1, p0), sub(p2, p0));
+  return n[0].is_zero() && n[1].is_zero() && n[2].is_zero();
+}
+
+RoundingGuard::RoundingGuard() : saved_(static_cast<unsigned>(CGAL::FPU_get_cw())) {
+  CGAL::FPU_set_cw(CGAL_FE_UPWARD);
+}
+RoundingGuard::~RoundingGuard() { CGAL::FPU_set_cw(static_cast<CGAL::FPU_CW_t>(saved_)); }
+
+}  // namespace bsprt

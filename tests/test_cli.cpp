@@ -1,0 +1,111 @@
+// The bsprt CLI end to end: runs the real binary, checks files and exit codes.
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "geometry/ray_io.h"
+#include "test_util.h"
+
+using namespace bsprt;
+using bsprt::test::scene_path;
+using bsprt::test::temp_path;
+
+namespace {
+
+struct Run {
+  int status;
+  std::string output;  // stdout and stderr
+};
+
+/// Runs `bsprt ARGS` and captures what it prints.
+Run bsprt_cli(const std::string& args) {
+  const std::string cmd = std::string(BSPRT_CLI_PATH) + " " + args + " 2>&1";
+  Run run{0, {}};
+  FILE* pipe = popen(cmd.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), int(buf.size()), pipe)) run.output += buf.data();
+  const int rc = pclose(pipe);
+  run.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("render of the default scene writes a PNG of the asked size", "[cli]") {
+  const std::string png = temp_path("cli_default.png");
+  std::filesystem::remove(png);
+  const Run r = bsprt_cli("render -o " + png + " --size 64 48 --accel brute");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  std::ifstream in(png, std::ios::binary);
+  REQUIRE(in);
+  std::array<unsigned char, 24> head{};
+  in.read(reinterpret_cast<char*>(head.data()), head.size());
+  CHECK(head[1] == 'P');
+  CHECK(head[2] == 'N');
+  CHECK(head[3] == 'G');
+  const auto be32 = [&](int o) { return (head[o] << 24) | (head[o + 1] << 16) | (head[o + 2] << 8) | head[o + 3]; };
+  CHECK(be32(16) == 64);
+  CHECK(be32(20) == 48);
+  CHECK(r.output.find("Mrays/s") != std::string::npos);
+}
+
+TEST_CASE("trace --accel brute and --accel embree agree on random rays", "[cli]") {
+  for (const char* mesh : {"cube.obj", "suzanne.obj", "utah-teapot.obj"}) {
+    const std::string scene = scene_path(mesh);
+    const std::string rays = temp_path("cli_random.rays");
+    const std::string brute = temp_path("cli_brute.hits"), embree = temp_path("cli_embree.hits");
+    REQUIRE(bsprt_cli("gen-rays " + scene + " --kind random -n 3000 --seed 5 -o " + rays).status == 0);
+    const Run b = bsprt_cli("trace " + scene + " " + rays + " -o " + brute + " --accel brute");
+    const Run e = bsprt_cli("trace " + scene + " " + rays + " -o " + embree + " --accel embree");
+    INFO(b.output << e.output);
+    REQUIRE(b.status == 0);
+    REQUIRE(e.status == 0);
+    CHECK(b.output.find("Mrays/s") != std::string::npos);
+    const auto hb = read_hits(brute), he = read_hits(embree);
+    REQUIRE(hb.size() == 3000);
+    REQUIRE(he.size() == 3000);
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < hb.size(); ++i) {
+      INFO(mesh << " ray " << i);
+      REQUIRE(hb[i].hit() == he[i].hit());
+      if (!hb[i].hit()) continue;
+      ++hits;
+      CHECK(hb[i].t == Approx(he[i].t).epsilon(1e-5));
+    }
+    CHECK(hits > 100);  // the comparison covered real hits
+  }
+}
+
+TEST_CASE("bad input gives a clear error naming the file and a non-zero exit", "[cli]") {
+  const std::string bad = temp_path("cli_bad.obj");
+  std::ofstream(bad) << "v 0 0 0\nv 1 0 0\nf 1 2 7\n";
+  const Run r = bsprt_cli("info " + bad);
+  CHECK(r.status == 1);
+  CHECK(r.output.find(bad) != std::string::npos);
+
+  const Run u = bsprt_cli("info " + temp_path("scene.xyz"));
+  CHECK(u.status != 0);
+  CHECK(u.output.find("scene.xyz") != std::string::npos);
+
+  const std::string rays = temp_path("cli_bad.rays");
+  std::ofstream(rays) << "SYAR garbage";
+  const Run t = bsprt_cli("trace default " + rays + " -o " + temp_path("x.hits"));
+  CHECK(t.status == 1);
+  CHECK(t.output.find("cli_bad.rays") != std::string::npos);
+
+  const Run a = bsprt_cli("trace default " + rays + " -o x.hits --accel warp-drive");
+  CHECK(a.status != 0);
+}
+
+TEST_CASE("info reports counts of a shared mesh", "[cli]") {
+  const Run r = bsprt_cli("info " + scene_path("suzanne.obj"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("triangles   968") != std::string::npos);
+}

@@ -1,0 +1,41 @@
+#pragma once
+/// \file tracer.h
+/// The one interface every accelerator and oracle implements (brute force, kd,
+/// BSP, Embree), so the CLI, tests and benchmarks can swap them by name.
+
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "geometry/ray.h"
+#include "traverse/counters.h"
+
+namespace bsprt {
+
+/// Nearest-hit ray tracer over one fixed scene.
+class Tracer {
+ public:
+  virtual ~Tracer() = default;
+
+  /// Short name as used by `--accel` ("brute", "kd", "bsp", "embree").
+  virtual std::string name() const = 0;
+
+  /// Nearest hit of one ray in [tnear, tfar]; invalid rays miss. Adds its work
+  /// to `counters` when non-null. Must be safe to call from many threads.
+  virtual Hit trace(const Ray& ray, RayCounters* counters = nullptr) const = 0;
+
+  /// Traces rays[i] into hits[i] (hits.size() == rays.size()), from one thread.
+  /// Coherent batches may use packets of `packet_width` rays (1 = single rays);
+  /// the default loops over `trace`. Results must equal single-ray results.
+  virtual void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width = 1,
+                           RayCounters* counters = nullptr) const {
+    (void)packet_width;
+    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
+  }
+
+  /// Bytes held by the acceleration structure (0 for brute force).
+  virtual std::size_t memory_bytes() const { return 0; }
+};
+
+}  // namespace bsprt
