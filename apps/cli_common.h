@@ -42,5 +42,10 @@ void register_trace(CLI::App& app);
 void register_render(CLI::App& app);
 void register_info(CLI::App& app);
 void register_gen_rays(CLI::App& app);
+void register_compare(CLI::App& app);
+void register_build(CLI::App& app);  // build and stats
+
+/// Thrown by `compare` when the files disagree: exit code 1, nothing more printed.
+struct CompareFailed {};
 
 }  // namespace bsprt::cli

@@ -15,10 +15,14 @@ int main(int argc, char** argv) {
   bsprt::cli::register_render(app);
   bsprt::cli::register_info(app);
   bsprt::cli::register_gen_rays(app);
+  bsprt::cli::register_compare(app);
+  bsprt::cli::register_build(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const bsprt::cli::CompareFailed&) {
+    return 1;
   } catch (const bsprt::InputError& e) {
     fmt::print(stderr, "bsprt: error: {}\n", e.what());
     return 1;

@@ -70,8 +70,9 @@ TriangleSoup make_torus_knot(Vec3f center, float radius, float tube, int p, int 
     const double u = two_pi * i / segments;
     const Vec3d c = curve(u);
     const Vec3d tangent = normalize(curve(u + 1e-4) - curve(u - 1e-4));
-    Vec3d normal = normalize(cross(tangent, curve(u + 1e-4) + curve(u - 1e-4) - c * 2.0));
-    if (!std::isfinite(normal.x)) normal = normalize(cross(tangent, Vec3d{0, 0, 1}));
+    // The (p, q) knot's tangent always has a large xy part, so a frame built
+    // against +z is smooth (a curvature frame twists where curvature vanishes).
+    const Vec3d normal = normalize(cross(tangent, Vec3d{0, 0, 1}));
     const Vec3d binormal = cross(tangent, normal);
     for (int j = 0; j < sides; ++j) {
       const double v = two_pi * j / sides;

@@ -15,7 +15,7 @@
 /// | OBJ | a `v` line whose x, y or z `>> double` cannot read (nan, inf, 1.#IND) is skipped, shifting every later index | pre-pass finds them, writes "0" in their place for OpenMesh, puts the value back after |
 /// | OBJ | repeated indices in a face are removed, a face left with < 3 corners is dropped | pre-pass reads each face's indices; we triangulate those and check OpenMesh's face is their de-duplication |
 /// | OBJ | negative indices | OpenMesh resolves them (counting `v` lines); the pre-pass does too and they must agree |
-/// | OBJ | a missing .mtl only warns | fine: materials are not used |
+/// | OBJ | `mtllib` opens and reads any named file (relative to a stale folder when reading a stream) | pre-pass blanks `mtllib` lines: materials are not used |
 /// | PLY/OFF text | `>> float` on nan/inf fails and derails every later value | pre-pass blanks them to "0" and records them |
 /// | PLY/OFF | fewer values than the header declares: reads stop at EOF (PLY) or read garbage (OFF faces); more: ignored | pre-pass walks every element and requires the exact count, byte or token |
 /// | PLY | list properties other than vertex_indices (before/in the face element) are skipped as one scalar | rejected with an InputError |
@@ -23,6 +23,7 @@
 /// | OFF | counts on the OFF line are lost; comments and face colors without a 'C' header derail it | pre-pass moves the counts to their own line, blanks comments and those colors |
 /// | STL | corners are merged and a facet whose corners merged is dropped | pre-pass reads every facet's corners; dropped facets are put back in place |
 /// | STL | ascii vs binary chosen by file size; NaN breaks its vertex map | a size fitting neither is an error; non-finite STLs bypass OpenMesh (see load_stl) |
+/// | STL ascii | any line containing "outer" starts a facet ("solid outer_shell") | pre-pass blanks the solid's name |
 ///
 /// After the read, every count and value that both OpenMesh and the pre-pass
 /// saw is compared, and any disagreement is an InputError: nothing is dropped

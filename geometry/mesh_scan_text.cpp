@@ -155,6 +155,9 @@ void scan_obj_face(const std::string& path, std::string_view line, std::size_t& 
 
 ObjScan scan_obj(const std::string& path, std::string& bytes) {
   ObjScan scan;
+  // A UTF-8 byte order mark would hide the first line's keyword from both
+  // OpenMesh and us; make it blanks.
+  if (bytes.compare(0, 3, "\xEF\xBB\xBF") == 0) bytes.replace(0, 3, "   ");
   LineCursor lines(bytes);
   std::string_view line;
   while (lines.next(line)) {
@@ -164,6 +167,12 @@ ObjScan scan_obj(const std::string& path, std::string& bytes) {
       scan_obj_vertex(path, bytes, line, i, lines.number(), scan);
     else if (keyword == "f")
       scan_obj_face(path, line, i, lines.number(), scan);
+    else if (keyword == "mtllib")
+      // OpenMesh would open and read the named file (relative to whatever
+      // folder its reader singleton last saw; with "/dev/zero" it reads until a
+      // 2 GB line fails).
+      // Materials are not used: blank the line.
+      blank_out(bytes, line, ' ');
   }
   // Positive indices may refer forward (OpenMesh reads all `v` lines first).
   for (std::size_t f = 0; f < scan.face_count(); ++f)
@@ -326,7 +335,9 @@ ElementScan scan_off(const std::string& path, std::string& bytes) {
 
 namespace {
 
-void scan_stl_binary(const std::string& path, const std::string& bytes, StlScan& scan) {
+/// Binary STL records: normal, 3 corners, attribute count (little-endian
+/// floats; this host is little-endian, as OpenMesh's reader also assumes).
+void scan_stl_binary(const std::string& bytes, StlScan& scan) {
   std::uint32_t n = 0;
   std::memcpy(&n, bytes.data() + 80, 4);
   scan.corners.resize(std::size_t{n} * 3);
@@ -340,7 +351,6 @@ void scan_stl_binary(const std::string& path, const std::string& bytes, StlScan&
         if (!std::isfinite(xyz[a])) scan.nonfinite.push_back({3 * f + static_cast<std::size_t>(k), a, xyz[a], -1});
     }
   }
-  (void)path;
 }
 
 struct StlState {
@@ -407,7 +417,7 @@ StlScan scan_stl(const std::string& path, std::string& bytes) {
   if (bytes.size() >= 84) std::memcpy(&n, bytes.data() + 80, 4);
   if (bytes.size() >= 84 && bytes.size() == 84 + 50 * std::uint64_t{n}) {
     scan.binary = true;
-    scan_stl_binary(path, bytes, scan);
+    scan_stl_binary(bytes, scan);
     return scan;
   }
   std::size_t i = 0;

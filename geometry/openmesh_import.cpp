@@ -8,6 +8,7 @@
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <algorithm>
 #include <iostream>
 #include <mutex>
 #include <sstream>

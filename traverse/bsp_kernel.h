@@ -1,0 +1,172 @@
+#pragma once
+/// \file bsp_kernel.h
+/// Internal to the BSP traversal: the certified interval arithmetic of one
+/// node step, written once for float and for SIMD vectors (vfloat<W>) so the
+/// scalar traversal (bsp_traverse.cpp) and the per-ISA packet kernels
+/// (bsp_packet.inl) perform the same IEEE operations in the same order (all
+/// these files are compiled with -ffp-contract=off), hence bit-identical
+/// intervals. The derivation of every constant is in docs/certified-epsilons.md.
+///
+/// Everything inline lives in the ISA inline namespace of simd.h (ODR: the
+/// AVX-512 copy of an inline function must never serve the baseline caller).
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "geometry/ray.h"
+#include "traverse/bsp_node.h"
+#include "traverse/counters.h"
+#include "traverse/simd.h"
+
+namespace bsprt {
+
+namespace detail {
+
+/// Widening of a computed crossing parameter q: the interval of a child is
+/// clipped at up(q) = max(q·(1+2^-21), q·(1-2^-21)) + 2^-126 (or dn(q), the
+/// mirror), more than the γ_3 ≈ 3u relative error of q and its own rounding;
+/// 2^-126 covers underflow. Docs §3.
+inline constexpr float kWidenHi = 1.0f + 0x1p-21f;
+inline constexpr float kWidenLo = 1.0f - 0x1p-21f;
+inline constexpr float kTiny = 0x1p-126f;
+/// Upper bound of ‖n‖₁ of every plane node's float normal (√3 for a unit
+/// vector, checked by flatten and FlatBspTree::validate()).
+inline constexpr float kNormL1Max = 1.7321f;
+/// Per-ray error coefficients: err_o = kErrCoef·max|o_i| + kErrAbs bounds (twice
+/// over) the γ_4 rounding of n·o, err_d = kErrCoef·max|dir_i| + kErrAbs the γ_3
+/// rounding of n·dir plus the flush of a subnormal slope. kErrCoef = 8u·‖n‖₁.
+inline constexpr float kErrCoef = kNormL1Max * 0x1p-21f;
+inline constexpr float kErrAbs = 0x1p-120f;
+/// Rays outside this magnitude range are traced in the fallback mode where
+/// every node passes both children (correct, slow): |o_i| <= 2^64, and
+/// 2^-64 <= max|dir_i| <= 2^64.
+inline constexpr float kSafeMax = 0x1p64f;
+inline constexpr float kSafeMinDir = 0x1p-64f;
+
+/// Raw view of a BspTracer for kernels that must not instantiate std::
+/// templates compiled for their ISA.
+struct BspView {
+  const FlatBspNode* nodes;
+  const std::uint32_t* prims;
+  const BspTriangle* triangles;  ///< parallel to prims
+  Box3f bounds;                  ///< root cell
+  bool certified;                ///< false: the zero-epsilon variant (per-ray errors 0)
+};
+
+/// Per-ray constants of the traversal, made once per ray by bsp_ray_setup.
+struct BspRayConst {
+  float o[3];        ///< origin
+  float dir[3];      ///< direction
+  float inv[3];      ///< 1/dir_k; NaN when dir_k is subnormal or the ray is unsafe
+  bool neg[3];       ///< sign bit of inv[k]: kd near child is the upper one
+  float err_o;       ///< certified error of n·o + d at t = 0 (inf: unsafe ray)
+  float err_d;       ///< certified error of n·dir, per unit of |t|
+  float tmin, tmax;  ///< ray segment clipped (conservatively) to the root cell
+  bool live;         ///< valid ray with a non-empty clipped segment
+};
+
+/// Single-ray trace used by kernels for lanes that leave a packet.
+using BspSingleFn = Hit (*)(const BspView& view, const Ray& ray, RayCounters* counters);
+
+/// Packet kernels: rays[0..count) into hits, W = 4 / 8 / 16 at a time. Call only
+/// when detected_isa() supports them. Results and counters equal single rays.
+void bsp_trace_packets_sse42(const BspView& view, const Ray* rays, std::size_t count, Hit* hits,
+                             RayCounters* counters);
+void bsp_trace_packets_avx2(const BspView& view, const Ray* rays, std::size_t count, Hit* hits,
+                            RayCounters* counters);
+void bsp_trace_packets_avx512(const BspView& view, const Ray* rays, std::size_t count, Hit* hits,
+                              RayCounters* counters);
+
+inline namespace BSPRT_ISA_NAMESPACE {
+
+/// |x| for float and vfloat alike (NaN stays NaN; -0 stays -0, which compares
+/// equal to 0).
+template <typename F>
+inline F gabs(F x) {
+  return x < 0.0f ? -x : x;
+}
+
+/// Conservative upper end of a crossing parameter (see kWidenHi). NaN stays NaN
+/// and then means "no constraint" at the caller.
+template <typename F>
+inline F widen_up(F q) {
+  const F a = q * kWidenHi, b = q * kWidenLo;
+  return (a > b ? a : b) + kTiny;
+}
+/// Conservative lower end of a crossing parameter.
+template <typename F>
+inline F widen_dn(F q) {
+  const F a = q * kWidenHi, b = q * kWidenLo;
+  return (a < b ? a : b) - kTiny;
+}
+
+/// kd node on axis k: crossing t = (split - o_k)·(1/dir_k), widened. Near is the
+/// lower child unless dir_k is negative. dir_k = ±0 gives ±inf (the ray stays on
+/// one side), a ray in the plane gives NaN (both children, whole interval).
+template <typename F>
+inline void kd_cut(float split, F o_k, F inv_k, F& near_hi, F& far_lo) {
+  const F t = (split - o_k) * inv_k;
+  near_hi = widen_up(t);
+  far_lo = widen_dn(t);
+}
+
+/// Plane node (docs/certified-epsilons.md §2-3): a = fl(n·o + d), b = fl(n·dir)
+/// (flushed to +0 when subnormal), E = eps + err_o + err_d·max(|t0|, |t1|)
+/// bounds |exact plane(o + t·dir) − (a + b·t)| over the cell for every t in
+/// [t0, t1]. The first child (value <= 0) needs a + b·t <= E, the second
+/// a + b·t >= −E. Returns the slope b: near is the first child iff b >= 0.
+template <typename F>
+inline F plane_cut(const FlatBspNode& n, const F (&o)[3], const F (&dir)[3], F err_o, F err_d, F t0,
+                   F t1, F& near_hi, F& far_lo) {
+  const F a = ((n.n[0] * o[0] + n.n[1] * o[1]) + n.n[2] * o[2]) + n.d;
+  F b = (n.n[0] * dir[0] + n.n[1] * dir[1]) + n.n[2] * dir[2];
+  b = gabs(b) < kTiny ? F{} : b;
+  const F at0 = gabs(t0), at1 = gabs(t1);
+  const F e = (n.eps + err_o) + err_d * (at0 > at1 ? at0 : at1);
+  const F inv = 1.0f / b;
+  const F q_first = (e - a) * inv, q_second = (-e - a) * inv;
+  const auto flip = b < 0.0f;
+  near_hi = widen_up(flip ? q_second : q_first);
+  far_lo = widen_dn(flip ? q_first : q_second);
+  return b;
+}
+
+/// Per-ray constants: reciprocals, error coefficients, and the segment clipped
+/// to the root box with widened slab crossings (NaN slabs, from a ray in a
+/// slab plane or a subnormal direction component, do not clip).
+inline BspRayConst bsp_ray_setup(const Ray& ray, const Box3f& root, bool certified) {
+  BspRayConst c{};
+  c.tmin = ray.tnear;
+  c.tmax = ray.tfar;
+  c.live = is_valid(ray);
+  if (!c.live) return c;
+  float mo = 0.0f, md = 0.0f;
+  for (int k = 0; k < 3; ++k) {
+    c.o[k] = ray.org[k];
+    c.dir[k] = ray.dir[k];
+    mo = gabs(c.o[k]) > mo ? gabs(c.o[k]) : mo;
+    md = gabs(c.dir[k]) > md ? gabs(c.dir[k]) : md;
+  }
+  const bool safe = mo <= kSafeMax && md <= kSafeMax && md >= kSafeMinDir;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int k = 0; k < 3; ++k) {
+    const bool sub = c.dir[k] != 0.0f && gabs(c.dir[k]) < kTiny;
+    c.inv[k] = safe && !sub ? 1.0f / c.dir[k] : nan;
+    c.neg[k] = std::signbit(c.inv[k]);
+  }
+  c.err_o = !safe ? std::numeric_limits<float>::infinity() : certified ? kErrCoef * mo + kErrAbs : 0.0f;
+  c.err_d = certified ? kErrCoef * md + kErrAbs : 0.0f;
+  for (int k = 0; k < 3; ++k) {
+    const float ta = (root.lo[k] - c.o[k]) * c.inv[k], tb = (root.hi[k] - c.o[k]) * c.inv[k];
+    const float enter = widen_dn(c.neg[k] ? tb : ta), exit = widen_up(c.neg[k] ? ta : tb);
+    c.tmin = enter > c.tmin ? enter : c.tmin;
+    c.tmax = exit < c.tmax ? exit : c.tmax;
+  }
+  c.live = c.tmin <= c.tmax;
+  return c;
+}
+
+}  // namespace BSPRT_ISA_NAMESPACE
+}  // namespace detail
+}  // namespace bsprt
