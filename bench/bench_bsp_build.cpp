@@ -8,6 +8,8 @@
 //     --bsp-max N          BspConfig::bsp_max_triangles
 //     --bsh-min N          BspConfig::bsh_min_triangles
 //     --kd-only            no face/edge candidates
+//     --min-gain X         BspConfig::min_gain
+//     --max-depth N        BspConfig::max_depth
 //     --bsh-scaling        count with and without the BSH on growing spheres
 #include <fmt/core.h>
 
@@ -103,6 +105,8 @@ int main(int argc, char** argv) {
     else if (a == "--coplanar-one-side") cfg.coplanar_to_both = false;
     else if (a == "--bsp-max") cfg.bsp_max_triangles = std::stoull(next());
     else if (a == "--bsh-min") cfg.bsh_min_triangles = std::stoull(next());
+    else if (a == "--min-gain") cfg.min_gain = std::stod(next());
+    else if (a == "--max-depth") cfg.max_depth = std::stoi(next());
     else if (a == "--kd-only") cfg.face_candidates = cfg.edge_candidates = false;
     else if (a == "--bsh-scaling") scaling = true;
     else scenes.push_back(a);

@@ -19,6 +19,7 @@
 /// | PLY/OFF text | `>> float` on nan/inf fails and derails every later value | pre-pass blanks them to "0" and records them |
 /// | PLY/OFF | fewer values than the header declares: reads stop at EOF (PLY) or read garbage (OFF faces); more: ignored | pre-pass walks every element and requires the exact count, byte or token |
 /// | PLY | list properties other than vertex_indices (before/in the face element) are skipped as one scalar | rejected with an InputError |
+/// | PLY | the header parser loops forever on some malformed lines (e.g. "format ascii x.0") | we parse the header strictly and hand OpenMesh a rebuilt one |
 /// | PLY/OFF | indices arrive unsigned (a negative one wraps) | range-checked in the pre-pass and again here |
 /// | OFF | counts on the OFF line are lost; comments and face colors without a 'C' header derail it | pre-pass moves the counts to their own line, blanks comments and those colors |
 /// | STL | corners are merged and a facet whose corners merged is dropped | pre-pass reads every facet's corners; dropped facets are put back in place |
@@ -186,6 +187,8 @@ void cross_check_elements(const std::string& path, const ElementScan& scan, cons
 
 Polygons load_elements(const std::string& path, std::string& bytes, const std::string& ext) {
   ElementScan scan = ext == "ply" ? detail::scan_ply(path, bytes) : detail::scan_off(path, bytes);
+  if (scan.body_offset != 0 || !scan.openmesh_header.empty())
+    bytes = scan.openmesh_header + bytes.substr(scan.body_offset);
   OpenMeshResult om = detail::openmesh_read(path, bytes, ext);
   cross_check_elements(path, scan, om);
   if (!scan.binary) patch_nonfinite(om.vertices, scan.nonfinite);

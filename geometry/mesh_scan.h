@@ -65,6 +65,10 @@ struct ElementScan {
   std::vector<Vec3f> coords;                ///< the pass's own reading (text: non-finite as 0)
   std::vector<std::int64_t> vertex_line;    ///< text files: 1-based line of each vertex
   std::vector<NonFiniteCoord> nonfinite;    ///< every non-finite x/y/z (text: blanked to 0)
+  /// OpenMesh reads `openmesh_header` followed by bytes[body_offset..] (PLY:
+  /// a rebuilt header; OFF: the file as is).
+  std::string openmesh_header;
+  std::size_t body_offset = 0;
 };
 ElementScan scan_ply(const std::string& path, std::string& bytes);
 ElementScan scan_off(const std::string& path, std::string& bytes);

@@ -41,6 +41,7 @@ struct PlyProperty {
   PlyType count_type;
   int axis = -1;           ///< 0..2 for x, y, z of the vertex element
   bool indices = false;    ///< vertex_indices of the face element
+  std::string decl;        ///< the declaration, normalized
 };
 
 struct PlyElement {
@@ -54,6 +55,7 @@ enum class PlyFormat { ascii, binary_le, binary_be };
 
 struct PlyHeader {
   PlyFormat format = PlyFormat::ascii;
+  std::string format_name;
   std::vector<PlyElement> elements;
   std::size_t body = 0;            ///< byte offset of the first body byte
   std::int64_t body_line = 0;      ///< line number of the first body line (ascii)
@@ -62,18 +64,44 @@ struct PlyHeader {
 void add_property(const std::string& path, std::int64_t no, std::string_view line, std::size_t i, PlyElement& e) {
   PlyProperty p;
   std::string_view t = next_token(line, i);
+  std::string_view count_name;
   if (t == "list") {
     p.list = true;
-    if (!ply_type(next_token(line, i), p.count_type) || p.count_type.floating)
+    count_name = next_token(line, i);
+    if (!ply_type(count_name, p.count_type) || p.count_type.floating)
       throw InputError(path, no, "PLY list count type must be an integer type");
     t = next_token(line, i);
   }
   if (!ply_type(t, p.type)) throw InputError(path, no, "unknown PLY property type " + quote(t));
   p.name = std::string(next_token(line, i));
-  if (p.name.empty()) throw InputError(path, no, "PLY property without a name");
+  if (p.name.empty() || !next_token(line, i).empty())
+    throw InputError(path, no, "PLY property line must be 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
   if (e.name == "vertex" && !p.list) p.axis = p.name == "x" ? 0 : p.name == "y" ? 1 : p.name == "z" ? 2 : -1;
   p.indices = e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
+  p.decl = "property " + (p.list ? "list " + std::string(count_name) + " " : std::string()) + std::string(t) + " " + p.name;
   e.props.push_back(std::move(p));
+}
+
+void add_element(const std::string& path, std::int64_t no, std::string_view line, std::size_t i, PlyHeader& h) {
+  PlyElement e;
+  e.name = std::string(next_token(line, i));
+  std::int64_t n = 0;
+  if (e.name.empty() || !parse_index(next_token(line, i), n) || n < 0 || n > std::int64_t{0x7fffffff} ||
+      !next_token(line, i).empty())
+    throw InputError(path, no, "PLY element line must be 'element NAME COUNT' with 0 <= COUNT < 2^31");
+  e.count = static_cast<std::uint64_t>(n);
+  e.line = no;
+  h.elements.push_back(std::move(e));
+}
+
+void set_format(const std::string& path, std::int64_t no, std::string_view line, std::size_t i, PlyHeader& h) {
+  const std::string_view f = next_token(line, i);
+  h.format = f == "ascii" ? PlyFormat::ascii : f == "binary_little_endian" ? PlyFormat::binary_le
+           : f == "binary_big_endian" ? PlyFormat::binary_be
+           : throw InputError(path, no, "unknown PLY format " + quote(f));
+  if (next_token(line, i) != "1.0" || !next_token(line, i).empty())
+    throw InputError(path, no, "PLY format line must be 'format " + std::string(f) + " 1.0'");
+  h.format_name = std::string(f);
 }
 
 PlyHeader parse_ply_header(const std::string& path, const std::string& bytes) {
@@ -88,19 +116,10 @@ PlyHeader parse_ply_header(const std::string& path, const std::string& bytes) {
     const std::string_view kw = next_token(line, i);
     const std::int64_t no = lines.number();
     if (kw == "format") {
-      const std::string_view f = next_token(line, i);
-      h.format = f == "ascii" ? PlyFormat::ascii : f == "binary_little_endian" ? PlyFormat::binary_le
-               : f == "binary_big_endian" ? PlyFormat::binary_be
-               : throw InputError(path, no, "unknown PLY format " + quote(f));
+      set_format(path, no, line, i, h);
       have_format = true;
     } else if (kw == "element") {
-      PlyElement e;
-      e.name = std::string(next_token(line, i));
-      std::int64_t n = 0;
-      if (!parse_index(next_token(line, i), n) || n < 0) throw InputError(path, no, "PLY element count must be an integer >= 0");
-      e.count = static_cast<std::uint64_t>(n);
-      e.line = no;
-      h.elements.push_back(std::move(e));
+      add_element(path, no, line, i, h);
     } else if (kw == "property") {
       if (h.elements.empty()) throw InputError(path, no, "PLY property before any element");
       add_property(path, no, line, i, h.elements.back());
@@ -114,6 +133,19 @@ PlyHeader parse_ply_header(const std::string& path, const std::string& bytes) {
   h.body = lines.offset();
   h.body_line = lines.number() + 1;
   return h;
+}
+
+/// The header as OpenMesh will read it: rebuilt from what we parsed, one
+/// declaration per line, without comments. OpenMesh 9.0's header parser loops
+/// forever (printing to omerr) on some malformed lines, e.g. a bad version;
+/// a canonical header keeps whatever we accepted within what it handles.
+std::string canonical_header(const PlyHeader& h) {
+  std::string s = "ply\nformat " + h.format_name + " 1.0\n";
+  for (const PlyElement& e : h.elements) {
+    s += "element " + e.name + " " + std::to_string(e.count) + "\n";
+    for (const PlyProperty& p : e.props) s += p.decl + "\n";
+  }
+  return s + "end_header\n";
 }
 
 /// OpenMesh reads the vertex and face elements and skips other elements
@@ -330,6 +362,8 @@ ElementScan scan_ply(const std::string& path, std::string& bytes) {
   ElementScan scan;
   check_supported(path, header, scan);
   scan.binary = header.format != PlyFormat::ascii;
+  scan.openmesh_header = canonical_header(header);
+  scan.body_offset = header.body;
   scan.coords.reserve(std::min<std::size_t>(scan.vertices, 1u << 24));
   if (scan.binary)
     walk_binary(path, bytes, header, scan);

@@ -105,6 +105,34 @@ class SoupImporter final : public omio::BaseImporter {
   OpenMeshResult& out_;
 };
 
+/// Keeps the first 4096 characters written to it and counts the rest, so that
+/// a reader printing in a loop cannot exhaust memory.
+class CappedBuffer final : public std::streambuf {
+ public:
+  std::string text() const {
+    return dropped_ ? text_ + "... (" + std::to_string(dropped_) + " more characters)" : text_;
+  }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (!traits_type::eq_int_type(c, traits_type::eof())) put(traits_type::to_char_type(c));
+    return traits_type::not_eof(c);
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    for (std::streamsize i = 0; i < n; ++i) put(s[i]);
+    return n;
+  }
+
+ private:
+  void put(char c) {
+    if (text_.size() < kCap) text_.push_back(c);
+    else ++dropped_;
+  }
+  static constexpr std::size_t kCap = 4096;
+  std::string text_;
+  std::size_t dropped_ = 0;
+};
+
 /// Library code must not print. OpenMesh writes warnings to its global
 /// streams omerr/omlog/omout (by default forwarded to std::cerr/clog/cout) and
 /// in a few places straight to std::cerr. For the duration of a read, detach
@@ -119,7 +147,7 @@ class CaptureOpenMeshOutput {
     ::omerr().connect(sink_);
     ::omlog().connect(sink_);
     ::omout().connect(sink_);
-    saved_cerr_ = std::cerr.rdbuf(sink_.rdbuf());
+    saved_cerr_ = std::cerr.rdbuf(&buffer_);
   }
   ~CaptureOpenMeshOutput() {
     ::omerr().flush();
@@ -140,11 +168,12 @@ class CaptureOpenMeshOutput {
     ::omerr().flush();
     ::omlog().flush();
     ::omout().flush();
-    return sink_.str();
+    return buffer_.text();
   }
 
  private:
-  std::ostringstream sink_;
+  CappedBuffer buffer_;
+  std::ostream sink_{&buffer_};
   std::streambuf* saved_cerr_ = nullptr;
 };
 

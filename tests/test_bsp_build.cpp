@@ -380,3 +380,28 @@ TEST_CASE("bsp: tree file round trip and rejection", "[bsp][file]") {
   const TriangleSoup other = uv_sphere(5, 12);
   CHECK_THROWS_AS(read_bsp_file(path, other), InputError);
 }
+
+TEST_CASE("bsp: progress reaches the total, report adds up", "[bsp]") {
+  const TriangleSoup s = uv_sphere(10, 20);
+  double last = -1, total = 0;
+  int calls = 0;
+  BspBuildReport rep;
+  BspConfig c;
+  c.parallel_min_triangles = 16;  // exercise the parallel path and the serialized callback
+  const BspTree t = build_bsp(s, c, &rep, [&](double done, double tot) {
+    CHECK(done >= last);
+    last = done;
+    total = tot;
+    ++calls;
+  });
+  CHECK(calls > 0);
+  CHECK(last == Approx(total));
+  std::size_t hist = 0, refs = 0;
+  for (std::size_t i = 0; i < rep.leaf_histogram.size(); ++i) {
+    hist += rep.leaf_histogram[i];
+    refs += i * rep.leaf_histogram[i];
+  }
+  CHECK(hist == rep.leaves);
+  CHECK(refs == t.triangle_refs().size());
+  CHECK(check_leaves(s, t) == "");
+}

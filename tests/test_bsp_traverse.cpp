@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <limits>
+#include <chrono>
+#include <cstdlib>
 #include <random>
 
 #include "bsp_test_util.h"
@@ -278,6 +280,73 @@ TEST_CASE("BSP work per ray: certified vs zero epsilon vs kd-tree", "[bsp][repor
                  per(z.kd_node_visits), per(z.triangle_tests), per(d.kd_node_visits),
                  per(d.triangle_tests));
       CHECK(z.bsp_node_visits + z.kd_node_visits <= a.bsp_node_visits + a.kd_node_visits);
+    }
+  }
+}
+
+TEST_CASE("BSP comparison catches a tree whose planes were moved", "[bsp]") {
+  // The oracle must be able to fail: move every split a little (plane offsets
+  // and kd coordinates, epsilons zeroed) and lost hits must be reported.
+  const BspScene s = build_bsp_scene(load_mesh(scene_path("suzanne.obj")));
+  FlatBspTree bad = s.flat;
+  for (FlatBspNode& n : bad.nodes) {
+    if (n.is_plane()) n.d += 2e-3f, n.eps = 0.0f;
+    else if (n.is_kd() && n.split() > bad.bounds.lo[n.axis()] + 4e-3f) n.n[0] -= 2e-3f;
+  }
+  const BspTracer tracer(bad, s.soup, BspEpsilon::Zero);
+  const std::vector<Ray> rays = all_ray_sets(s.soup, 1000, 5);
+  const Comparison c = compare_with_brute(s.soup, tracer, rays);
+  CHECK(c.lost + c.farther > 0);
+  CHECK_FALSE(c.ok());
+}
+
+TEST_CASE("BSP zero-epsilon variant: lost hits on stiff rays (report)", "[.report]") {
+  for (const char* name : {"suzanne.obj", "utah-teapot.obj"}) {
+    const BspScene s = build_bsp_scene(load_mesh(scene_path(name)));
+    const BspTracer zero(s.flat, s.soup, BspEpsilon::Zero);
+    const std::vector<Ray> rays = all_ray_sets(s.soup, 5000, 9);
+    const Comparison c = compare_with_brute(s.soup, zero, rays);
+    fmt::print("zero-eps {:16} rays {} lost {} farther {} ties {}\n", name, c.rays, c.lost,
+               c.farther, c.ties);
+  }
+}
+
+TEST_CASE("BSP vs kd speed on one mesh (manual: BSPRT_BENCH_MESH=file)", "[.bench]") {
+  const char* mesh = std::getenv("BSPRT_BENCH_MESH");
+  const std::string name = mesh ? mesh : "utah-teapot.obj";
+  const auto now = [] { return std::chrono::steady_clock::now(); };
+  const auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  TriangleSoup soup = load_mesh(scene_path(name));
+  BspConfig cfg;
+  if (const char* m = std::getenv("BSPRT_BSP_MAX_TRIS")) cfg.bsp_max_triangles = std::stoull(m);
+  auto t0 = now();
+  BspScene s = build_bsp_scene(std::move(soup), cfg);
+  auto t1 = now();
+  FlattenReport fr;
+  s.flat = flatten_bsp(s.soup, s.exact, &fr);
+  const KdTracer kd(build_kd(s.soup), s.soup);
+  fmt::print("{}: build+flatten {:.2f}s (flatten {:.2f}s), plane nodes {}, kd nodes {} ({} from planes), "
+             "max eps {:.3g}, mean eps {:.3g}, max eps/cell {:.3g}\n", name, secs(t0, t1), fr.seconds,
+             fr.plane_nodes, fr.kd_nodes, fr.kd_from_planes, fr.max_eps, fr.mean_eps, fr.max_eps_rel_cell);
+  const BspTracer bsp(s.flat, s.soup);
+  for (RaySetKind k : {RaySetKind::Primary, RaySetKind::Random}) {
+    const std::vector<Ray> rays = make_rays(k, s.soup, 1 << 18, 1);
+    std::vector<Hit> h(rays.size());
+    for (int w : {1, 4, 8, 16}) {
+      if (int(detected_isa()) < int(isa_for_width(w))) continue;
+      RayCounters cb, ck;
+      auto a = now();
+      bsp.trace_batch(rays, h, w, nullptr);
+      auto b = now();
+      kd.trace_batch(rays, h, w, nullptr);
+      auto c = now();
+      bsp.trace_batch(rays, h, w, &cb);
+      kd.trace_batch(rays, h, w, &ck);
+      const double n = double(rays.size());
+      fmt::print("  {:8} w={:2}  bsp {:6.2f} Mrays/s  kd {:6.2f} Mrays/s  ratio {:.2f} | bsp nodes {:.1f}+{:.1f} tris {:.2f} | "
+                 "kd nodes {:.1f} tris {:.2f}\n", ray_set_name(k), w, n / secs(a, b) * 1e-6,
+                 n / secs(b, c) * 1e-6, secs(b, c) / secs(a, b), cb.kd_node_visits / n,
+                 cb.bsp_node_visits / n, cb.triangle_tests / n, ck.kd_node_visits / n, ck.triangle_tests / n);
     }
   }
 }

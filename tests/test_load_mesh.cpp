@@ -396,6 +396,17 @@ TEST_CASE("Errors: PLY counts that lie and truncation", "[load][errors]") {
   require_error(write_file("word.ply", head + "0 0 0\n1 zero 0\n0 1 0\n1 1 0\n3 0 1 2\n3 0 2 1\n"), "not a number");
   require_error(write_file("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"), "end_header");
   require_error(write_file("notply.ply", "hello\n"), "not a PLY file");
+  // Regression: OpenMesh 9.0's header parser loops forever on a bad version.
+  require_error(write_file("version.ply", "ply\nformat ascii f.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                          "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                          "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+                "1.0");
+  // Comments and odd spacing in the header are fine (OpenMesh gets a rebuilt header).
+  const TriangleSoup s = load_mesh(write_file("spaced.ply", "ply\ncomment hi there\nformat  ascii 1.0\nelement vertex 3\n"
+                                                             "property float x\nproperty float y\nproperty  float z\n"
+                                                             "obj_info x\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                                             "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+  CHECK(s.size() == 1);
 }
 
 namespace {

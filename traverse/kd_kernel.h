@@ -22,7 +22,7 @@ inline constexpr float kKdTHi = 1.0f + 0x1p-21f;
 struct KdView {
   const KdNode* nodes;
   const std::uint32_t* prims;
-  const KdTriangle* triangles;  ///< parallel to prims
+  const KdTriangle* triangles;  ///< by triangle number
   Box3f bounds;
 };
 

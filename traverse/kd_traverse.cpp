@@ -63,19 +63,11 @@ inline void intersect_leaf(const KdView& v, const KdNode& n, const WatertightRay
 /// branches let the CPU fetch the next node before t is known (a branch-free
 /// step measured 30% slower). A popped cell is skipped when its entry is past
 /// the nearest hit. kd_packet.inl repeats these steps lane by lane, bit for bit.
-template <bool kCount>
-Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
+template <bool kCount, bool kNonNegative>
+Hit trace_from(const KdView& v, const WatertightRay& wr, const float o[3],
+               const float inv[3], const bool neg[3], float tmin, float tmax, RayCounters* c) {
   Hit hit;
-  if constexpr (kCount) ++c->rays;
-  const WatertightRay wr = watertight_precompute(ray);
-  if (!wr.valid) return hit;
-  const float o[3] = {ray.org.x, ray.org.y, ray.org.z};
-  const float inv[3] = {1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};
-  const bool neg[3] = {std::signbit(ray.dir.x), std::signbit(ray.dir.y), std::signbit(ray.dir.z)};
-  float tmin = ray.tnear, tmax = ray.tfar;
-  clip_root(v.bounds, o, inv, neg, tmin, tmax);
-  if (!(tmin <= tmax)) return hit;
-  StackEntry stack[kKdMaxDepth + 1];
+  StackEntry stack[kKdMaxDepth];
   int sp = 0;
   std::uint32_t node = 0;
   for (;;) {
@@ -85,7 +77,14 @@ Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
       const int k = n->axis();
       const float t = (n->split - o[k]) * inv[k];
       const float ta = t * kKdTLo, tb = t * kKdTHi;
-      const float tl = ta < tb ? ta : tb, th = ta > tb ? ta : tb;
+      float tl, th;
+      if constexpr (kNonNegative) {
+        // tmin >= 0: for t < 0 the unordered pair decides exactly as the
+        // ordered one (both say: far only, from tmin), so skip the min/max.
+        tl = ta, th = tb;
+      } else {
+        tl = ta < tb ? ta : tb, th = ta > tb ? ta : tb;
+      }
       const std::uint32_t lower = node + 1, upper = n->upper_child();
       const std::uint32_t near = neg[k] ? upper : lower, far = neg[k] ? lower : upper;
       const bool go_near = !(th < tmin), go_far = !(tl > tmax);  // NaN: both
@@ -118,6 +117,22 @@ Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
       break;
     }
   }
+}
+
+template <bool kCount>
+Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
+  Hit hit;
+  if constexpr (kCount) ++c->rays;
+  const WatertightRay wr = watertight_precompute(ray);
+  if (!wr.valid) return hit;
+  const float o[3] = {ray.org.x, ray.org.y, ray.org.z};
+  const float inv[3] = {1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};
+  const bool neg[3] = {std::signbit(ray.dir.x), std::signbit(ray.dir.y), std::signbit(ray.dir.z)};
+  float tmin = ray.tnear, tmax = ray.tfar;
+  clip_root(v.bounds, o, inv, neg, tmin, tmax);
+  if (!(tmin <= tmax)) return hit;
+  return tmin >= 0.0f ? trace_from<kCount, true>(v, wr, o, inv, neg, tmin, tmax, c)
+                      : trace_from<kCount, false>(v, wr, o, inv, neg, tmin, tmax, c);
 }
 
 Hit trace_single_counted(const KdView& v, const Ray& ray, RayCounters* c) {

@@ -20,8 +20,9 @@ namespace bsprt {
 /// Deepest tree the traversal stack holds (build_kd never builds deeper).
 inline constexpr int kKdMaxDepth = 64;
 
-/// A triangle's corners, copied in leaf order so a leaf's triangles are
-/// contiguous in memory (36 bytes each).
+/// A triangle's corners (36 bytes), copied from the soup by triangle number: one
+/// copy per triangle, not per leaf reference (a smaller footprint measured
+/// faster than leaf-ordered copies, which duplicate ~6x on scanned meshes).
 struct KdTriangle {
   Vec3f v[3];
 };
@@ -51,7 +52,7 @@ class KdTracer final : public Tracer {
 
  private:
   KdTree tree_;
-  std::vector<KdTriangle> triangles_;  ///< triangles_[i] = corners of tree_.prims[i]
+  std::vector<KdTriangle> triangles_;  ///< corners of triangle i (all of the soup)
 };
 
 }  // namespace bsprt

@@ -1,0 +1,157 @@
+#include "robust/exact_tracer.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/intersections.h>
+
+#include <cmath>
+#include <optional>
+#include <vector>
+
+namespace bsprt {
+namespace {
+
+using Epick = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Epeck = CGAL::Exact_predicates_exact_constructions_kernel;
+using TriangleList = std::vector<Epick::Triangle_3>;
+using Primitive = CGAL::AABB_triangle_primitive<Epick, TriangleList::const_iterator>;
+using AabbTree = CGAL::AABB_tree<CGAL::AABB_traits<Epick, Primitive>>;
+using FT = Epeck::FT;
+
+Epick::Point_3 to_epick(const Vec3f& p) { return {p.x, p.y, p.z}; }
+Epeck::Point_3 to_epeck(const Vec3f& p) { return {p.x, p.y, p.z}; }
+
+/// Exact ray parameter of point p on the ray o + t d (p is on the ray).
+FT param(const Epeck::Point_3& p, const Epeck::Point_3& o, const Epeck::Vector_3& d) {
+  return ((p - o) * d) / (d * d);
+}
+
+/// A candidate hit: exact t and the exact point.
+struct Candidate {
+  FT t;
+  Epeck::Point_3 p;
+};
+
+/// The exact point where the line o + t d meets the triangle, and its t, when
+/// t is in [tnear, tfar]. A line lying in the triangle's plane (a segment of
+/// overlap) does not hit it: the convention of the watertight test, which every
+/// bsprt tracer shares, so the reference measures the same thing.
+template <typename Query>
+std::optional<Candidate> exact_hit(const Epeck::Triangle_3& tri, const Query& query, const Epeck::Point_3& o,
+                                   const Epeck::Vector_3& d, const FT& tnear, const std::optional<FT>& tfar) {
+  const auto hit = CGAL::intersection(query, tri);
+  if (!hit) return std::nullopt;
+  const auto* p = boost::get<Epeck::Point_3>(&*hit);
+  if (!p) return std::nullopt;
+  const FT t = param(*p, o, d);
+  if (t < tnear || (tfar && t > *tfar)) return std::nullopt;
+  return Candidate{t, *p};
+}
+
+/// Barycentrics (u of v1, v of v2) of point p in triangle (a, b, c), exactly,
+/// by Cramer's rule in the projection that drops the normal's largest axis.
+std::pair<float, float> barycentrics(const Epeck::Point_3& p, const Epeck::Point_3& a, const Epeck::Point_3& b,
+                                     const Epeck::Point_3& c) {
+  const Epeck::Vector_3 e1 = b - a, e2 = c - a, w = p - a;
+  const Epeck::Vector_3 n = CGAL::cross_product(e1, e2);
+  int drop = 0;
+  if (CGAL::abs(n.y()) > CGAL::abs(n[drop])) drop = 1;
+  if (CGAL::abs(n.z()) > CGAL::abs(n[drop])) drop = 2;
+  const int i = (drop + 1) % 3, j = (drop + 2) % 3;
+  const FT det = e1[i] * e2[j] - e1[j] * e2[i];
+  const FT u = (w[i] * e2[j] - w[j] * e2[i]) / det;
+  const FT v = (e1[i] * w[j] - e1[j] * w[i]) / det;
+  return {float(CGAL::to_double(u)), float(CGAL::to_double(v))};
+}
+
+/// The float nearest to the exact value x (ties to even do not matter here).
+float round_to_float(const FT& x) {
+  const float f0 = float(CGAL::to_double(x));
+  float best = f0;
+  FT best_err = CGAL::abs(FT(f0) - x);
+  for (float f : {std::nextafter(f0, -INFINITY), std::nextafter(f0, INFINITY)}) {
+    const FT err = CGAL::abs(FT(f) - x);
+    if (err < best_err) best = f, best_err = err;
+  }
+  return best;
+}
+
+}  // namespace
+
+struct ExactTracer::Impl {
+  const TriangleSoup& soup;
+  TriangleList triangles;            // non-degenerate triangles, Epick
+  std::vector<std::uint32_t> prim;   // triangles[i] is triangle prim[i]
+  AabbTree tree;
+
+  explicit Impl(const TriangleSoup& s) : soup(s) {
+    for (std::uint32_t t = 0; t < s.size(); ++t) {
+      if (s.is_degenerate(t)) continue;
+      const auto [a, b, c] = s.corners(t);
+      triangles.emplace_back(to_epick(a), to_epick(b), to_epick(c));
+      prim.push_back(t);
+    }
+    tree.insert(triangles.begin(), triangles.end());
+    tree.build();
+  }
+};
+
+ExactTracer::ExactTracer(const TriangleSoup& soup) : impl_(std::make_unique<Impl>(soup)) {}
+ExactTracer::~ExactTracer() = default;
+
+std::size_t ExactTracer::memory_bytes() const {
+  return impl_->triangles.size() * (sizeof(Epick::Triangle_3) + sizeof(std::uint32_t)) +
+         impl_->tree.size() * 2 * sizeof(CGAL::Bbox_3);
+}
+
+Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
+  if (counters) ++counters->rays;
+  Hit best;
+  if (!is_valid(ray) || impl_->triangles.empty()) return best;
+  // Candidates from the AABB tree (exact predicates): a ray when the segment
+  // starts at or after the origin, else the whole line.
+  std::vector<TriangleList::const_iterator> candidates;
+  const Epick::Point_3 eo = to_epick(ray.org);
+  const Epick::Vector_3 ed(ray.dir.x, ray.dir.y, ray.dir.z);
+  if (ray.tnear >= 0.0f)
+    impl_->tree.all_intersected_primitives(Epick::Ray_3(eo, ed), std::back_inserter(candidates));
+  else
+    impl_->tree.all_intersected_primitives(Epick::Line_3(eo, ed), std::back_inserter(candidates));
+  if (candidates.empty()) return best;
+
+  const Epeck::Point_3 o = to_epeck(ray.org);
+  const Epeck::Vector_3 d(ray.dir.x, ray.dir.y, ray.dir.z);
+  const Epeck::Ray_3 exact_ray(o, d);
+  const Epeck::Line_3 exact_line(o, d);
+  const FT tnear = ray.tnear;
+  const std::optional<FT> tfar = std::isfinite(ray.tfar) ? std::optional<FT>(FT(ray.tfar)) : std::nullopt;
+  std::optional<FT> best_t;
+  std::optional<Epeck::Point_3> best_p;
+  std::uint32_t best_prim = kNoHit;
+  for (const auto& it : candidates) {
+    const std::size_t i = std::size_t(it - impl_->triangles.begin());
+    const std::uint32_t t = impl_->prim[i];
+    if (counters) ++counters->triangle_tests;
+    const auto [a, b, c] = impl_->soup.corners(t);
+    const Epeck::Triangle_3 tri(to_epeck(a), to_epeck(b), to_epeck(c));
+    const std::optional<Candidate> cand = ray.tnear >= 0.0f ? exact_hit(tri, exact_ray, o, d, tnear, tfar)
+                                                            : exact_hit(tri, exact_line, o, d, tnear, tfar);
+    if (!cand) continue;
+    if (!best_t || cand->t < *best_t || (cand->t == *best_t && t < best_prim)) {
+      best_t = cand->t, best_p = cand->p, best_prim = t;
+    }
+  }
+  if (!best_t) return best;
+  const auto [a, b, c] = impl_->soup.corners(best_prim);
+  const auto [u, v] = barycentrics(*best_p, to_epeck(a), to_epeck(b), to_epeck(c));
+  best.t = round_to_float(*best_t);
+  best.prim = best_prim;
+  best.u = u;
+  best.v = v;
+  return best;
+}
+
+}  // namespace bsprt
