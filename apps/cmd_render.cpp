@@ -1,24 +1,33 @@
-// `bsprt render [SCENE] -o out.png`: ray-casts a scene (the embedded default
-// scene when none is given) with eye-light shading into a PNG.
+// `bsprt render [SCENE] -o out.png --mode cast|path|heat`: ray casting with
+// packets, path tracing with single rays, and per-pixel cost heat maps, on any
+// accelerator (the embedded default scene when none is given).
 #include <fmt/core.h>
 
+#include <fstream>
 #include <memory>
 
 #include "apps/cli_common.h"
+#include "apps/heat_map.h"
+#include "apps/path_tracer.h"
 #include "apps/progress.h"
 #include "apps/render.h"
 #include "geometry/default_scene.h"
+#include "geometry/error.h"
 
 namespace bsprt::cli {
 namespace {
 
 struct RenderArgs {
-  std::string scene, output = "bsprt.png";
+  std::string scene, output = "bsprt.png", mode = "cast", json;
   TraceOptions trace;
   std::vector<int> size{800, 600};
   std::vector<float> vp, vi, vu;
   float fov = 0.0f;
   bool stats = false;
+  int spp = 16, bounces = 3;
+  std::uint64_t seed = 1;
+  std::string heat_metric = "nodes", heat_compare;
+  float heat_max = 0.0f;
 };
 
 Vec3f to_vec(const std::vector<float>& v) { return {v[0], v[1], v[2]}; }
@@ -33,6 +42,86 @@ Camera pick_camera(const RenderArgs& a, const TriangleSoup& soup) {
   return cam;
 }
 
+void write_image(const std::string& path, const Image& image) {
+  if (path.size() > 4 && path.substr(path.size() - 4) == ".pfm") write_pfm(path, image);
+  else write_png(path, image);
+}
+
+std::uint64_t tile_count(int w, int h) { return std::uint64_t((w + 15) / 16) * std::uint64_t((h + 15) / 16); }
+
+void run_cast(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& soup, RenderOptions options) {
+  RenderStats stats;
+  Image image;
+  {
+    ProgressBar bar("rendering", tile_count(options.width, options.height), "tiles", ProgressBar::stderr_is_terminal());
+    image = render_cast(tracer, soup, options, &stats, [&](std::uint64_t done, std::uint64_t) { bar.set(done); });
+  }
+  write_image(a.output, image);
+  fmt::print("cast {}x{} with {} in {:.3f} s ({:.2f} Mrays/s, {} of {} rays hit) -> {}\n", options.width,
+             options.height, tracer.name(), stats.seconds, stats.rays / stats.seconds * 1e-6, stats.hits, stats.rays,
+             a.output);
+  if (a.stats) {
+    const double n = double(stats.rays);
+    fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests\n",
+               stats.counters.kd_node_visits / n, stats.counters.bsp_node_visits / n,
+               stats.counters.leaf_visits / n, stats.counters.triangle_tests / n);
+  }
+}
+
+void run_path(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& soup, const RenderOptions& base) {
+  PathOptions options;
+  options.width = base.width, options.height = base.height, options.camera = base.camera;
+  options.spp = a.spp, options.bounces = a.bounces, options.seed = a.seed, options.packet_width = base.packet_width;
+  PathStats stats;
+  Image image;
+  {
+    ProgressBar bar(fmt::format("path tracing ({} spp)", a.spp), tile_count(options.width, options.height), "tiles",
+                    ProgressBar::stderr_is_terminal());
+    image = render_path(tracer, soup, options, &stats, [&](std::uint64_t done, std::uint64_t) { bar.set(done); });
+  }
+  write_image(a.output, image);
+  fmt::print("path {}x{} {} spp {} bounces with {} in {:.3f} s, {} rays, {} NaN pixels -> {}\n", options.width,
+             options.height, options.spp, options.bounces, tracer.name(), stats.seconds, stats.rays, stats.nan_pixels,
+             a.output);
+  std::string json = fmt::format("{{\"accel\": \"{}\", \"mode\": \"path\", \"width\": {}, \"height\": {}, \"spp\": {}, "
+                                 "\"bounces\": {}, \"seed\": {}, \"seconds\": {:.6f}, \"rays\": {}, \"nan_pixels\": {}, "
+                                 "\"by_bounce\": [",
+                                 tracer.name(), options.width, options.height, options.spp, options.bounces,
+                                 options.seed, stats.seconds, stats.rays, stats.nan_pixels);
+  for (std::size_t b = 0; b < stats.rays_by_bounce.size(); ++b) {
+    const double s = stats.trace_seconds_by_bounce[b];
+    const double mrays = s > 0 ? stats.rays_by_bounce[b] / s * 1e-6 : 0.0;
+    fmt::print("  bounce {}: {} rays, {:.2f} Mrays/s per thread\n", b, stats.rays_by_bounce[b], mrays);
+    json += fmt::format("{}{{\"bounce\": {}, \"rays\": {}, \"trace_thread_seconds\": {:.6f}, \"mrays_per_thread_second\": {:.4f}}}",
+                        b ? ", " : "", b, stats.rays_by_bounce[b], s, mrays);
+  }
+  json += "]}\n";
+  if (!a.json.empty()) std::ofstream(a.json) << json;
+}
+
+void run_heat(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& soup, const RenderOptions& options) {
+  const HeatMetric metric = parse_heat_metric(a.heat_metric);
+  const std::vector<float> cost = pixel_costs(tracer, options, metric);
+  Image image;
+  if (!a.heat_compare.empty()) {
+    TraceOptions other = a.trace;
+    other.accel = a.heat_compare;
+    other.tree.clear();
+    const std::unique_ptr<Tracer> b = make_accel(other, soup);
+    const std::vector<float> cost_b = pixel_costs(*b, options, metric);
+    image = heat_difference_image(cost, cost_b, options.width, options.height,
+                                  fmt::format("{} - {}\n{}", tracer.name(), b->name(), heat_metric_name(metric)));
+  } else {
+    image = heat_image(cost, options.width, options.height, a.heat_max,
+                       fmt::format("{}\n{}{}", tracer.name(), heat_metric_name(metric), metric == HeatMetric::Time ? " (ns)" : ""));
+  }
+  double sum = 0;
+  for (float c : cost) sum += c;
+  write_image(a.output, image);
+  fmt::print("heat map ({}) of {} {}x{}: mean {:.3f} per pixel -> {}\n", heat_metric_name(metric), tracer.name(),
+             options.width, options.height, sum / double(cost.size()), a.output);
+}
+
 void run(const RenderArgs& a) {
   const auto threads = limit_threads(a.trace.threads);
   const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, true);
@@ -42,38 +131,36 @@ void run(const RenderArgs& a) {
   options.height = a.size[1];
   options.camera = pick_camera(a, soup);
   options.packet_width = a.trace.packets;
-  RenderStats stats;
-  Image image;
-  {
-    const std::uint64_t tiles = std::uint64_t((options.width + 15) / 16) * std::uint64_t((options.height + 15) / 16);
-    ProgressBar bar("rendering", tiles, "tiles", ProgressBar::stderr_is_terminal());
-    image = render_cast(*tracer, soup, options, &stats, [&](std::uint64_t done, std::uint64_t) { bar.set(done); });
-  }
-  write_png(a.output, image);
-  fmt::print("rendered {}x{} with {} in {:.3f} s ({:.2f} Mrays/s, {} of {} rays hit) -> {}\n", options.width,
-             options.height, tracer->name(), stats.seconds, stats.rays / stats.seconds * 1e-6, stats.hits,
-             stats.rays, a.output);
-  if (a.stats) {
-    const double n = double(stats.rays);
-    fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests\n",
-               stats.counters.kd_node_visits / n, stats.counters.bsp_node_visits / n,
-               stats.counters.leaf_visits / n, stats.counters.triangle_tests / n);
-  }
+  if (a.mode == "cast") return run_cast(a, *tracer, soup, options);
+  if (a.mode == "path") return run_path(a, *tracer, soup, options);
+  if (a.mode == "heat") return run_heat(a, *tracer, soup, options);
+  throw UsageError("--mode must be cast, path or heat, not '" + a.mode + "'");
 }
 
 }  // namespace
 
 void register_render(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  CLI::App* cmd = app.add_subcommand("render", "ray-cast a scene into a PNG (eye-light shading)");
+  CLI::App* cmd = app.add_subcommand("render", "render a scene: ray casting, path tracing or cost heat maps");
   cmd->add_option("SCENE", args->scene, "mesh file, or omit / 'default' for the embedded default scene");
-  cmd->add_option("-o,--output", args->output, "PNG file to write")->capture_default_str();
+  cmd->add_option("-o,--output", args->output, "image to write (.png, or .pfm for raw radiance)")->capture_default_str();
+  cmd->add_option("--mode", args->mode, "cast (eye light, packets) | path (path tracing) | heat (cost per pixel)")
+      ->capture_default_str();
   cmd->add_option("--size", args->size, "image width and height")->expected(2)->capture_default_str();
   cmd->add_option("--vp", args->vp, "camera position X Y Z")->expected(3);
   cmd->add_option("--vi", args->vi, "camera look-at point X Y Z")->expected(3);
   cmd->add_option("--vu", args->vu, "camera up vector X Y Z")->expected(3);
   cmd->add_option("--fov", args->fov, "vertical field of view in degrees");
-  cmd->add_flag("--stats", args->stats, "count and print node visits and triangle tests per ray");
+  cmd->add_flag("--stats", args->stats, "cast: count and print node visits and triangle tests per ray");
+  cmd->add_option("--spp", args->spp, "path: samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--bounces", args->bounces, "path: indirect bounces (0 = direct light)")->capture_default_str()
+      ->check(CLI::Range(0, 64));
+  cmd->add_option("--seed", args->seed, "path: random seed (images are identical for any thread count)")
+      ->capture_default_str();
+  cmd->add_option("--json", args->json, "path: write a JSON summary (rays, Mrays/s by bounce) to this file");
+  cmd->add_option("--heat-metric", args->heat_metric, "heat: time | nodes | tests")->capture_default_str();
+  cmd->add_option("--heat-compare", args->heat_compare, "heat: draw the difference to this accelerator's map");
+  cmd->add_option("--heat-max", args->heat_max, "heat: top of the colour scale (0 = the image's maximum)");
   add_trace_options(*cmd, args->trace, "embree");
   cmd->callback([args] { run(*args); });
 }

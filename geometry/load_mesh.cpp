@@ -305,7 +305,7 @@ std::size_t apply_nonfinite_policy(const std::string& path, const Polygons& p, c
     for (std::uint32_t v : soup.triangles[t]) {
       if (is_finite(soup.vertices[v])) continue;
       if (!options.allow_nonfinite)
-        throw InputError(path, p.line_of_vertex(v), "vertex " + std::to_string(v) + " " + describe(soup.vertices[v]) +
+        throw InputError(path, p.line_of_vertex(v), "vertex #" + std::to_string(v) + " (0-based) " + describe(soup.vertices[v]) +
                                                         " is not finite and triangle " + std::to_string(t) +
                                                         " uses it; allow_nonfinite keeps such triangles as never-hit degenerates");
       ++count;

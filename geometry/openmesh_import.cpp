@@ -134,46 +134,39 @@ class CappedBuffer final : public std::streambuf {
 };
 
 /// Library code must not print. OpenMesh writes warnings to its global
-/// streams omerr/omlog/omout (by default forwarded to std::cerr/clog/cout) and
-/// in a few places straight to std::cerr. For the duration of a read, detach
-/// the OpenMesh streams from the console, attach them to a string, and point
-/// std::cerr at the same string. Only valid under the global read mutex.
+/// streams omerr (forwarded to std::cerr), omlog and omout, and in a few
+/// places straight to std::cerr. For the duration of a read, std::cerr writes
+/// into a capped string and omlog/omout are disabled. (Reconnecting the
+/// OpenMesh streams instead would leak: mostream::disconnect never frees the
+/// target that connect allocated.) Only valid under the global read mutex;
+/// another thread's std::cerr output during a read is captured (dropped) too.
 class CaptureOpenMeshOutput {
  public:
-  CaptureOpenMeshOutput() {
-    ::omerr().disconnect(std::cerr);
-    ::omlog().disconnect(std::clog);
-    ::omout().disconnect(std::cout);
-    ::omerr().connect(sink_);
-    ::omlog().connect(sink_);
-    ::omout().connect(sink_);
+  CaptureOpenMeshOutput()
+      : log_was_enabled_(::omlog().is_enabled()), out_was_enabled_(::omout().is_enabled()) {
+    ::omerr().flush();
+    ::omlog().disable();
+    ::omout().disable();
     saved_cerr_ = std::cerr.rdbuf(&buffer_);
   }
   ~CaptureOpenMeshOutput() {
     ::omerr().flush();
-    ::omlog().flush();
-    ::omout().flush();
     std::cerr.rdbuf(saved_cerr_);
-    ::omerr().disconnect(sink_);
-    ::omlog().disconnect(sink_);
-    ::omout().disconnect(sink_);
-    ::omerr().connect(std::cerr);
-    ::omlog().connect(std::clog);
-    ::omout().connect(std::cout);
+    if (log_was_enabled_) ::omlog().enable();
+    if (out_was_enabled_) ::omout().enable();
   }
   CaptureOpenMeshOutput(const CaptureOpenMeshOutput&) = delete;
   CaptureOpenMeshOutput& operator=(const CaptureOpenMeshOutput&) = delete;
 
   std::string text() {
     ::omerr().flush();
-    ::omlog().flush();
-    ::omout().flush();
     return buffer_.text();
   }
 
  private:
   CappedBuffer buffer_;
-  std::ostream sink_{&buffer_};
+  bool log_was_enabled_;
+  bool out_was_enabled_;
   std::streambuf* saved_cerr_ = nullptr;
 };
 

@@ -118,8 +118,12 @@ void check_node(const TriangleSoup& soup, PlaneDef def, const Cell& cell, std::m
 EpsStats check_scene_eps(TriangleSoup soup) {
   const BspScene s = build_bsp_scene(std::move(soup));
   std::set<std::tuple<float, float, float, float, float>> stored;
-  for (const FlatBspNode& n : s.flat.nodes)
-    if (n.is_plane()) stored.insert({n.n[0], n.n[1], n.n[2], n.d, n.eps});
+  for (std::size_t i = 0; i < s.flat.nodes.size(); ++i) {  // tails follow their heads
+    const FlatBspNode& n = s.flat.nodes[i];
+    if (!n.is_plane()) continue;
+    const FlatBspNode& tail = s.flat.nodes[++i];
+    stored.insert({n.normal(0), n.normal(1), n.normal(2), tail.tail_d(), tail.tail_eps()});
+  }
   EpsStats st;
   std::mt19937 rng(17);
   s.exact.for_each_cell(s.soup, [&](std::uint32_t i, const Cell& cell) {

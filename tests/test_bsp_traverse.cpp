@@ -91,7 +91,7 @@ void check_scene(const std::string& name, TriangleSoup soup, std::size_t n = 600
 }  // namespace
 
 TEST_CASE("flat BSP node layout and a hand-built tree", "[bsp]") {
-  STATIC_REQUIRE(sizeof(FlatBspNode) == 32);
+  STATIC_REQUIRE(sizeof(FlatBspNode) == 16);
   // Two triangles at x = -1 and x = +1 separated by the slanted plane x + y = 0.
   TriangleSoup soup;
   soup.vertices = {{-1, -1, -1}, {-1, 1, -1}, {-1, 0, 1}, {1, -1, -1}, {1, 1, -1}, {1, 0, 1}};
@@ -102,8 +102,8 @@ TEST_CASE("flat BSP node layout and a hand-built tree", "[bsp]") {
   t.triangle_count = 2;
   const float h = float(1.0 / std::sqrt(2.0));
   const float n[3] = {h, h, 0.0f};
-  t.nodes = {FlatBspNode::make_plane(n, 0.0f, 1e-6f, 2), FlatBspNode::make_leaf(0, 1),
-             FlatBspNode::make_leaf(1, 1)};
+  t.nodes = {FlatBspNode::make_plane_head(n, 3), FlatBspNode::make_plane_tail(0.0f, 1e-6f),
+             FlatBspNode::make_leaf(0, 1), FlatBspNode::make_leaf(1, 1)};
   t.prims = {0, 1};
   REQUIRE_NOTHROW(t.validate());
   // (The hand-built tree is not certified for this geometry: triangle 0 crosses
@@ -118,7 +118,7 @@ TEST_CASE("flat BSP node layout and a hand-built tree", "[bsp]") {
   CHECK(c.rays == 2);
   CHECK(c.bsp_node_visits == 2);
   FlatBspTree bad = t;
-  bad.nodes[0].bits = (1u << 3) | 3u;  // second child == first child
+  bad.nodes[0].bits = (2u << 3) | 3u;  // second child == first child
   CHECK_THROWS(bad.validate());
 }
 
@@ -126,6 +126,10 @@ TEST_CASE("BSP hits equal brute force on shared meshes", "[bsp]") {
   for (const char* name : {"cube.obj", "suzanne.obj", "utah-teapot.obj", "stiff_degenerated.obj",
                            "stiff_planexy.off", "stiff_cube_with_fold.ply", "stiff_sliver_tet.ply"})
     check_scene(name, load_mesh(scene_path(name)));
+}
+
+TEST_CASE("BSP hits equal brute force on the bunny", "[bsp]") {
+  check_scene("stanford-bunny.obj", load_mesh(scene_path("stanford-bunny.obj")), 300);
 }
 
 TEST_CASE("BSP hits equal brute force on stiff generated scenes", "[bsp]") {
@@ -289,9 +293,15 @@ TEST_CASE("BSP comparison catches a tree whose planes were moved", "[bsp]") {
   // and kd coordinates, epsilons zeroed) and lost hits must be reported.
   const BspScene s = build_bsp_scene(load_mesh(scene_path("suzanne.obj")));
   FlatBspTree bad = s.flat;
-  for (FlatBspNode& n : bad.nodes) {
-    if (n.is_plane()) n.d += 2e-3f, n.eps = 0.0f;
-    else if (n.is_kd() && n.split() > bad.bounds.lo[n.axis()] + 4e-3f) n.n[0] -= 2e-3f;
+  for (std::size_t i = 0; i < bad.nodes.size(); ++i) {
+    FlatBspNode& n = bad.nodes[i];
+    if (n.is_plane()) {
+      FlatBspNode& tail = bad.nodes[++i];
+      tail.set_tail_d(tail.tail_d() + 2e-3f);
+      tail.set_tail_eps(0.0f);
+    } else if (n.is_kd() && n.split() > bad.bounds.lo[n.axis()] + 4e-3f) {
+      n.set_split(n.split() - 2e-3f);
+    }
   }
   const BspTracer tracer(bad, s.soup, BspEpsilon::Zero);
   const std::vector<Ray> rays = all_ray_sets(s.soup, 1000, 5);

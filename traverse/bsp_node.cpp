@@ -11,17 +11,17 @@
 namespace bsprt {
 namespace {
 
-/// Checks the plane of an inner node: finite, ‖n‖₁ within the bound the
+/// Checks a plane node (head and tail): finite, ‖n‖₁ within the bound the
 /// traversal's error coefficients assume (kNormL1Max = 1.7321), ‖n‖₂ ≈ 1.
-void check_plane(const FlatBspNode& n) {
-  const double l1 = std::fabs(double(n.n[0])) + std::fabs(double(n.n[1])) + std::fabs(double(n.n[2]));
-  const double l2 = std::sqrt(double(n.n[0]) * n.n[0] + double(n.n[1]) * n.n[1] +
-                              double(n.n[2]) * n.n[2]);
-  BSPRT_CHECK(std::isfinite(n.d));
-  BSPRT_CHECK(std::isfinite(n.eps));
+void check_plane(const FlatBspNode& head, const FlatBspNode& tail) {
+  const double n[3] = {head.normal(0), head.normal(1), head.normal(2)};
+  const double l1 = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
+  const double l2 = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  BSPRT_CHECK(std::isfinite(tail.tail_d()));
+  BSPRT_CHECK(std::isfinite(tail.tail_eps()));
   BSPRT_CHECK_LE(l1, 1.73206);  // √3 + 1e-5 < kNormL1Max (bsp_kernel.h)
   BSPRT_CHECK_LE(std::fabs(l2 - 1.0), 1e-6);
-  BSPRT_CHECK_LE(0.0f, n.eps);
+  BSPRT_CHECK_LE(0.0f, tail.tail_eps());
 }
 
 }  // namespace
@@ -42,36 +42,38 @@ void FlatBspTree::validate() const {
     const FlatBspNode& n = nodes[i];
     BSPRT_CHECK_LE(n.bits & 7u, 4u);
     if (n.is_leaf()) {
-      const std::uint64_t end = std::uint64_t(n.prim_offset) + n.prim_count;
+      const std::uint64_t end = std::uint64_t(n.prim_offset()) + n.prim_count();
       BSPRT_CHECK_LE(end, prims.size());
-      for (std::uint64_t k = n.prim_offset; k < end; ++k) {
+      for (std::uint64_t k = n.prim_offset(); k < end; ++k) {
         BSPRT_CHECK_EQ(prim_used[k], 0);  // leaf lists do not overlap
         prim_used[k] = 1;
         BSPRT_CHECK_LT(prims[k], triangle_count);
       }
       continue;
     }
-    const std::uint32_t second = n.second_child();
-    BSPRT_CHECK_LT(i + 1, nodes.size());
+    const std::uint32_t first = i + n.slots(), second = n.second_child();
+    BSPRT_CHECK_LT(first, nodes.size());
     BSPRT_CHECK_LT(second, nodes.size());
-    BSPRT_CHECK_LT(i + 1, second);
+    BSPRT_CHECK_LT(first, second);
     if (n.is_plane()) {
-      check_plane(n);
+      check_plane(n, nodes[i + 1]);
+      BSPRT_CHECK_EQ(seen[i + 1], 0);  // the tail is never a node
+      seen[i + 1] = 1;
+      ++reached;
     } else {
       BSPRT_CHECK(std::isfinite(n.split()));
       BSPRT_CHECK_LE(bounds.lo[n.axis()], n.split());
       BSPRT_CHECK_LE(n.split(), bounds.hi[n.axis()]);
     }
     stack.push_back(second);
-    stack.push_back(i + 1);
+    stack.push_back(first);
   }
-  BSPRT_CHECK_EQ(reached, nodes.size());  // every node reached: counts add up
+  BSPRT_CHECK_EQ(reached, nodes.size());  // every slot reached once: counts add up
   BSPRT_CHECK(std::find(prim_used.begin(), prim_used.end(), 0) == prim_used.end());
 }
 
 FlatBspStats flat_bsp_stats(const FlatBspTree& tree) {
   FlatBspStats s;
-  s.nodes = tree.nodes.size();
   s.bytes = tree.memory_bytes();
   double scale = 0.0;
   for (int k = 0; k < 3; ++k)
@@ -85,19 +87,20 @@ FlatBspStats flat_bsp_stats(const FlatBspTree& tree) {
     s.max_depth = std::max(s.max_depth, depth);
     if (n.is_leaf()) {
       ++s.leaves;
-      s.empty_leaves += n.prim_count == 0;
-      s.references += n.prim_count;
+      s.empty_leaves += n.prim_count() == 0;
+      s.references += n.prim_count();
       continue;
     }
     if (n.is_plane()) {
       ++s.plane_nodes;
-      if (scale > 0) s.max_rel_eps = std::max(s.max_rel_eps, double(n.eps) / scale);
+      if (scale > 0) s.max_rel_eps = std::max(s.max_rel_eps, double(tree.nodes[i + 1].tail_eps()) / scale);
     } else {
       ++s.kd_nodes;
     }
     stack.push_back({n.second_child(), depth + 1});
-    stack.push_back({i + 1, depth + 1});
+    stack.push_back({i + n.slots(), depth + 1});
   }
+  s.nodes = s.leaves + s.plane_nodes + s.kd_nodes;
   return s;
 }
 

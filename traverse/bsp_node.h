@@ -1,13 +1,14 @@
 #pragma once
 /// \file bsp_node.h
 /// The flat float BSP tree that traversal reads (Ize, Wald, Parker, "Ray
-/// Tracing with the BSP Tree", RT 2008, §5): 32-byte nodes in depth-first order
-/// (first child adjacent), general planes with a *certified* slab bound, kd
-/// nodes for axis-aligned splits (the paper's "kd-tree traversal for
-/// axis-aligned splits": no dot product), and one array of leaf triangle lists.
-/// Made once from the exact tree by builder/bsp_flatten.h; traced by
+/// Tracing with the BSP Tree", RT 2008, §5): 16-byte kd nodes and leaves,
+/// 32-byte plane nodes carrying a *certified* slab bound, depth-first with the
+/// first child adjacent; axis-aligned splits stay kd nodes (the paper's "kd-tree
+/// traversal for axis-aligned splits": no dot product); one array of leaf
+/// triangle lists. Made once from the exact tree by builder/bsp_flatten.h; traced by
 /// traverse/bsp_traverse.h. No CGAL here.
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -23,17 +24,20 @@ inline constexpr int kBspMaxDepth = 128;
 /// What a FlatBspNode is. Values 0..2 are kd nodes on that axis.
 enum class FlatBspNodeKind : std::uint32_t { KdX = 0, KdY = 1, KdZ = 2, Plane = 3, Leaf = 4 };
 
-/// One node of the flat BSP tree, 32 bytes, two per cache line. Byte layout
-/// (little-endian):
+/// One 16-byte slot of the flat BSP tree: kd nodes and leaves take one slot,
+/// plane nodes two (head + tail), so the common kd node costs a quarter of a
+/// cache line. Byte layout (little-endian):
 ///
-///   offset size  Plane node            kd node              leaf
-///   0      12    float n[3] (unit)     n[0] = float split   unused (0)
-///   12     4     float d               unused (0)           unused (0)
-///   16     4     float eps (certified) unused (0)           unused (0)
-///   20     4     bits 0-2: kind (FlatBspNodeKind); bits 3-31: index of the second
-///                child (inner nodes; the first child is the next node) / 0
-///   24     4     unused (0)            unused (0)           uint32 first entry in prims
-///   28     4     unused (0)            unused (0)           uint32 triangle count
+///   offset size  kd node          leaf               plane head         plane tail
+///   0      4     bits             bits               bits               float d
+///   4      4     float split      uint32 first prim  float n[0] (unit)  float eps
+///   8      4     0                uint32 prim count  float n[1]         0
+///   12     4     0                0                  float n[2]         0
+///
+/// bits: 0-2 kind (FlatBspNodeKind), 3-31 index of the second child (inner
+/// nodes; 0 for leaves). The first child follows the node: index + 1 for kd
+/// nodes, index + 2 for plane nodes (after the tail). A tail is never entered
+/// as a node.
 ///
 /// Plane node: the first child is the closed half-space n·x + d <= 0 (the
 /// exact plane's negative side), the second n·x + d >= 0. The float plane is
@@ -41,36 +45,37 @@ enum class FlatBspNodeKind : std::uint32_t { KdX = 0, KdY = 1, KdZ = 2, Plane = 
 /// cell plus the rounding of the constant term, so traversal can be
 /// conservative (docs/certified-epsilons.md). kd node: first child is
 /// x_axis <= split, second x_axis >= split; split is an exact float.
-struct alignas(32) FlatBspNode {
-  float n[3] = {0.0f, 0.0f, 0.0f};  ///< plane normal; kd: n[0] is the split
-  float d = 0.0f;                   ///< plane offset
-  float eps = 0.0f;                 ///< certified slab half-width at t = 0 (see docs)
+struct alignas(16) FlatBspNode {
   std::uint32_t bits = std::uint32_t(FlatBspNodeKind::Leaf);  ///< kind | second child << 3
-  std::uint32_t prim_offset = 0;    ///< leaf: first entry in FlatBspTree::prims
-  std::uint32_t prim_count = 0;     ///< leaf: number of triangles
+  std::uint32_t w[3] = {0, 0, 0};  ///< payload words (see the layout table)
 
   /// Largest child index a node can store (29 bits).
   static constexpr std::uint32_t kMaxIndex = (1u << 29) - 1;
 
-  static FlatBspNode make_plane(const float normal[3], float offset, float epsilon,
-                            std::uint32_t second) {
-    FlatBspNode b;
-    b.n[0] = normal[0], b.n[1] = normal[1], b.n[2] = normal[2];
-    b.d = offset;
-    b.eps = epsilon;
-    b.bits = (second << 3) | std::uint32_t(FlatBspNodeKind::Plane);
-    return b;
-  }
   static FlatBspNode make_kd(int axis, float split, std::uint32_t second) {
     FlatBspNode b;
-    b.n[0] = split;
+    b.w[0] = std::bit_cast<std::uint32_t>(split);
     b.bits = (second << 3) | std::uint32_t(axis);
     return b;
   }
   static FlatBspNode make_leaf(std::uint32_t offset, std::uint32_t count) {
     FlatBspNode b;
-    b.prim_offset = offset;
-    b.prim_count = count;
+    b.w[0] = offset;
+    b.w[1] = count;
+    return b;
+  }
+  /// Head slot of a plane node (the tail must follow it).
+  static FlatBspNode make_plane_head(const float normal[3], std::uint32_t second) {
+    FlatBspNode b;
+    for (int i = 0; i < 3; ++i) b.w[i] = std::bit_cast<std::uint32_t>(normal[i]);
+    b.bits = (second << 3) | std::uint32_t(FlatBspNodeKind::Plane);
+    return b;
+  }
+  /// Tail slot of a plane node: offset and certified epsilon.
+  static FlatBspNode make_plane_tail(float offset, float epsilon) {
+    FlatBspNode b;
+    b.bits = std::bit_cast<std::uint32_t>(offset);
+    b.w[0] = std::bit_cast<std::uint32_t>(epsilon);
     return b;
   }
 
@@ -78,20 +83,33 @@ struct alignas(32) FlatBspNode {
   bool is_leaf() const { return (bits & 7u) == std::uint32_t(FlatBspNodeKind::Leaf); }
   bool is_plane() const { return (bits & 7u) == std::uint32_t(FlatBspNodeKind::Plane); }
   bool is_kd() const { return (bits & 7u) < 3u; }
+  /// Slots this node takes (2 for plane nodes).
+  std::uint32_t slots() const { return is_plane() ? 2u : 1u; }
   /// Axis of a kd node.
   int axis() const { return int(bits & 7u); }
   /// Split coordinate of a kd node.
-  float split() const { return n[0]; }
-  /// Inner node: index of the second child (the first is this index + 1).
+  float split() const { return std::bit_cast<float>(w[0]); }
+  /// Inner node: index of the second child (the first is index + slots()).
   std::uint32_t second_child() const { return bits >> 3; }
+  /// Leaf: first entry in FlatBspTree::prims and number of triangles.
+  std::uint32_t prim_offset() const { return w[0]; }
+  std::uint32_t prim_count() const { return w[1]; }
+  /// Plane head: normal component i.
+  float normal(int i) const { return std::bit_cast<float>(w[i]); }
+  /// Plane tail: offset d and epsilon.
+  float tail_d() const { return std::bit_cast<float>(bits); }
+  float tail_eps() const { return std::bit_cast<float>(w[0]); }
+  void set_tail_d(float d) { bits = std::bit_cast<std::uint32_t>(d); }
+  void set_tail_eps(float e) { w[0] = std::bit_cast<std::uint32_t>(e); }
+  void set_split(float s) { w[0] = std::bit_cast<std::uint32_t>(s); }
 };
-static_assert(sizeof(FlatBspNode) == 32, "FlatBspNode must be 32 bytes");
-static_assert(alignof(FlatBspNode) == 32, "FlatBspNode must be 32-byte aligned");
+static_assert(sizeof(FlatBspNode) == 16, "FlatBspNode must be 16 bytes");
+static_assert(alignof(FlatBspNode) == 16, "FlatBspNode must be 16-byte aligned");
 
 /// The flat BSP tree over one triangle soup. Node 0 is the root; its cell is
 /// the box `bounds` (the exact root cell, whose corners are floats).
 struct FlatBspTree {
-  std::vector<FlatBspNode> nodes;         ///< depth-first, root first
+  std::vector<FlatBspNode> nodes;         ///< slots, depth-first, root first
   std::vector<std::uint32_t> prims;   ///< leaf triangle lists (triangle numbers)
   Box3f bounds;                       ///< root cell
   std::uint32_t triangle_count = 0;   ///< triangles of the scene (for checks)

@@ -75,11 +75,11 @@ inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count
 template <int W, bool kCount>
 inline void packet_leaf(const BspView& v, const FlatBspNode& n, const WatertightPacket<W>& pre,
                         PacketHit<W>& hit, vmask<W> active, RayCounters* c) {
-  const std::uint32_t first = n.prim_offset, end = first + n.prim_count;
+  const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if constexpr (kCount) {
     const std::uint64_t a = lanes<W>(active);
     c->leaf_visits += a;
-    c->triangle_tests += a * n.prim_count;
+    c->triangle_tests += a * n.prim_count();
   }
   for (std::uint32_t i = first; i < end; ++i) {
     const BspTriangle& t = v.triangles[i];
@@ -93,7 +93,7 @@ template <int W>
 inline vmask<W> cut_node(const FlatBspNode& n, const BspPacketRay<W>& r, vfloat<W> tmin,
                          vfloat<W> tmax, vfloat<W>& near_hi, vfloat<W>& far_lo) {
   if (n.is_plane()) {
-    const vfloat<W> b = detail::plane_cut<vfloat<W>>(n, r.o, r.dir, r.err_o, r.err_d, tmin, tmax,
+    const vfloat<W> b = detail::plane_cut<vfloat<W>>(&n, r.o, r.dir, r.err_o, r.err_d, tmin, tmax,
                                                      near_hi, far_lo);
     return b < 0.0f;
   }
@@ -116,11 +116,11 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPa
     while (!n->is_leaf()) {
       vfloat<W> near_hi, far_lo;
       const vmask<W> flip = cut_node<W>(*n, r, tmin, tmax, near_hi, far_lo);
-      const vmask<W> flipped = active & flip, straight = active & ~flip;
-      if (any<W>(flipped) && any<W>(straight)) {  // disagreeing lanes redo this node later
-        const unsigned m = movemask<W>(active);
-        const bool lead_flips = (movemask<W>(flipped) & (m & (0u - m))) != 0;
-        const vmask<W> keep = lead_flips ? flipped : straight;
+      const unsigned am = movemask<W>(active), fm = movemask<W>(active & flip);
+      bool fl = fm != 0;
+      if (fl && fm != am) {  // disagreeing lanes redo this node later
+        fl = (fm & (am & (0u - am))) != 0;  // the lowest active lane decides
+        const vmask<W> keep = fl ? (active & flip) : (active & ~flip);
         stack[sp++] = {node, tmin, tmax, active & ~keep, mask_false<W>()};
         active = keep;
       }
@@ -128,8 +128,7 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPa
         if (n->is_plane()) c->bsp_node_visits += lanes<W>(active);
         else c->kd_node_visits += lanes<W>(active);
       }
-      const bool fl = any<W>(active & flip);
-      const std::uint32_t first = node + 1, second = n->second_child();
+      const std::uint32_t first = node + n->slots(), second = n->second_child();
       const std::uint32_t near = fl ? second : first, far = fl ? first : second;
       const vmask<W> go_near = active & ~(near_hi < tmin), go_far = active & ~(far_lo > tmax);
       const vfloat<W> near_max = near_hi < tmax ? near_hi : tmax;

@@ -27,10 +27,10 @@ struct StackEntry {
 template <bool kCount>
 inline void intersect_leaf(const BspView& v, const FlatBspNode& n, const WatertightRay& wr, Hit& hit,
                            RayCounters* c) {
-  const std::uint32_t first = n.prim_offset, end = first + n.prim_count;
+  const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if constexpr (kCount) {
     ++c->leaf_visits;
-    c->triangle_tests += n.prim_count;
+    c->triangle_tests += n.prim_count();
   }
   for (std::uint32_t i = first; i < end; ++i) {
     const BspTriangle& t = v.triangles[i];
@@ -45,7 +45,7 @@ inline bool cut_node(const FlatBspNode& n, const BspRayConst& rc, float tmin, fl
                      float& near_hi, float& far_lo, RayCounters* c) {
   if (n.is_plane()) {
     if constexpr (kCount) ++c->bsp_node_visits;
-    const float b = detail::plane_cut<float>(n, rc.o, rc.dir, rc.err_o, rc.err_d, tmin, tmax,
+    const float b = detail::plane_cut<float>(&n, rc.o, rc.dir, rc.err_o, rc.err_d, tmin, tmax,
                                              near_hi, far_lo);
     return b < 0.0f;
   }
@@ -75,7 +75,7 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
     while (!n->is_leaf()) {
       float near_hi, far_lo;
       const bool flip = cut_node<kCount>(*n, rc, tmin, tmax, near_hi, far_lo, c);
-      const std::uint32_t first = node + 1, second = n->second_child();
+      const std::uint32_t first = node + n->slots(), second = n->second_child();
       const std::uint32_t near = flip ? second : first, far = flip ? first : second;
       const bool go_near = !(near_hi < tmin), go_far = !(far_lo > tmax);  // NaN: both
       if (go_far) {
@@ -127,8 +127,8 @@ BspTracer::BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode
   if (tree_depth(tree_) >= kBspMaxDepth)
     throw UsageError("BSP tree deeper than " + std::to_string(kBspMaxDepth) + " levels");
   if (mode_ == BspEpsilon::Zero)
-    for (FlatBspNode& n : tree_.nodes)
-      if (n.is_plane()) n.eps = 0.0f;
+    for (std::size_t i = 0; i + 1 < tree_.nodes.size(); ++i)
+      if (tree_.nodes[i].is_plane()) tree_.nodes[++i].set_tail_eps(0.0f);
   triangles_.resize(tree_.prims.size());
   for (std::size_t i = 0; i < tree_.prims.size(); ++i) {
     const auto c = soup.corners(tree_.prims[i]);
