@@ -4,6 +4,7 @@
 
 #include "apps/progress.h"
 #include "geometry/default_scene.h"
+#include "geometry/error.h"
 
 namespace bsprt::cli {
 
@@ -16,6 +17,10 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
   cmd.add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
   cmd.add_option("--packets", o.packets, "rays per packet: 1 (single rays), 4, 8 or 16")
       ->check(CLI::IsMember({1, 4, 8, 16}))
+      ->capture_default_str();
+  cmd.add_option("--membership", o.membership,
+                 "BSP builds: which triangles a leaf lists: area (positive-area overlap, the default) or closed "
+                 "(every triangle touching the closed cell)")
       ->capture_default_str();
   cmd.add_flag("--allow-nonfinite", o.allow_nonfinite,
                "keep triangles with NaN/Inf corners (flagged degenerate, never hit) instead of failing");
@@ -43,6 +48,12 @@ TriangleSoup load_scene(const std::string& path, bool allow_nonfinite, bool verb
   return soup;
 }
 
+BspMembership parse_membership(const std::string& name) {
+  if (name == "area") return BspMembership::Area;
+  if (name == "closed") return BspMembership::Closed;
+  throw UsageError("--membership must be area or closed, not '" + name + "'");
+}
+
 std::unique_ptr<tbb::global_control> limit_threads(int threads) {
   if (threads <= 0) return nullptr;
   return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -53,7 +64,15 @@ std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& so
   AccelOptions options;
   options.tree_path = o.tree;
   options.threads = o.threads;
-  options.progress = ProgressBar::stderr_is_terminal();
+  options.bsp.membership = parse_membership(o.membership);
+  const bool building = o.tree.empty() && (o.accel == "kd" || o.accel.rfind("bsp", 0) == 0);
+  std::unique_ptr<ProgressBar> bar;
+  if (building && ProgressBar::stderr_is_terminal()) {
+    bar = std::make_unique<ProgressBar>("building " + o.accel, 1000, "permille", true);
+    options.progress = [&bar](double done, double total) {
+      bar->set(total > 0 ? std::uint64_t(1000.0 * done / total) : 0);
+    };
+  }
   return make_tracer(o.accel, soup, options);
 }
 

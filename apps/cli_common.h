@@ -22,6 +22,7 @@ struct TraceOptions {
   int threads = 0;
   int packets = 1;
   bool allow_nonfinite = false;
+  std::string membership = "area";
 };
 
 /// Adds --accel, --tree, --threads, --packets, --allow-nonfinite to `cmd`.
@@ -30,6 +31,9 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
 /// Loads SCENE, or the embedded default scene when `path` is empty or
 /// "default"; prints a one-line load summary to stderr when `verbose`.
 TriangleSoup load_scene(const std::string& path, bool allow_nonfinite, bool verbose);
+
+/// "area" or "closed" (BspMembership); throws UsageError otherwise.
+BspMembership parse_membership(const std::string& name);
 
 /// Caps TBB's worker threads for the life of the returned object (0 = all cores).
 std::unique_ptr<tbb::global_control> limit_threads(int threads);

@@ -7,17 +7,24 @@
 
 #include "apps/cli_common.h"
 #include "apps/progress.h"
+#include "builder/bsp_build.h"
+#include "builder/bsp_file.h"
+#include "builder/bsp_flat_io.h"
+#include "builder/bsp_flatten.h"
 #include "builder/kd_build.h"
 #include "builder/kd_file.h"
 #include "builder/tree_file.h"
+#include "geometry/error.h"
+#include "traverse/bsp_node.h"
 
 namespace bsprt::cli {
 namespace {
 
 struct BuildArgs {
-  std::string scene, output, accel = "kd";
+  std::string scene, output, accel = "kd", membership = "area";
   int threads = 0;
   bool allow_nonfinite = false;
+  bool paper = false;  // the paper's full BSP: face/edge candidates at every node size
 };
 
 void print_kd_stats(const KdTreeStats& s) {
@@ -35,10 +42,87 @@ void build_kd_file(const BuildArgs& a, const TriangleSoup& soup) {
   fmt::print("wrote {}\n", a.output);
 }
 
+/// Split counts by depth, leaf sizes: what `bsprt build` and `stats` print for BSP trees.
+struct BspFigures {
+  std::vector<std::size_t> kd_by_depth, bsp_by_depth, leaf_histogram;
+  std::size_t nodes = 0, leaves = 0, refs = 0;
+};
+
+BspFigures bsp_figures(const std::vector<BspNode>& nodes, const std::vector<PlaneDef>& planes, const std::string& path) {
+  BspFigures f;
+  f.nodes = nodes.size();
+  std::vector<std::pair<std::uint32_t, std::size_t>> stack{{0, 0}};
+  std::size_t visited = 0;
+  while (!stack.empty()) {
+    const auto [i, depth] = stack.back();
+    stack.pop_back();
+    if (i >= nodes.size() || ++visited > nodes.size()) throw InputError(path, "BSP nodes do not form a tree");
+    const BspNode& n = nodes[i];
+    if (n.is_leaf()) {
+      ++f.leaves, f.refs += n.b;
+      if (f.leaf_histogram.size() <= n.b) f.leaf_histogram.resize(std::size_t(n.b) + 1, 0);
+      ++f.leaf_histogram[n.b];
+      continue;
+    }
+    if (n.plane >= planes.size()) throw InputError(path, "BSP node names a plane out of range");
+    auto& row = planes[n.plane].kind == PlaneKind::Kd ? f.kd_by_depth : f.bsp_by_depth;
+    if (row.size() <= depth) row.resize(depth + 1, 0);
+    ++row[depth];
+    stack.push_back({n.b, depth + 1});
+    stack.push_back({n.a, depth + 1});
+  }
+  return f;
+}
+
+void print_bsp_figures(const BspFigures& f) {
+  std::size_t kd = 0, bsp = 0;
+  for (std::size_t v : f.kd_by_depth) kd += v;
+  for (std::size_t v : f.bsp_by_depth) bsp += v;
+  const std::size_t nonempty = f.leaves - (f.leaf_histogram.empty() ? 0 : f.leaf_histogram[0]);
+  fmt::print("nodes {}, leaves {} ({} empty), {} kd splits, {} BSP (face/edge) splits, {:.2f} triangles per non-empty leaf\n",
+             f.nodes, f.leaves, f.leaves - nonempty, kd, bsp, nonempty ? double(f.refs) / double(nonempty) : 0.0);
+  fmt::print("splits by depth (depth: kd/bsp):");
+  const std::size_t depth = std::max(f.kd_by_depth.size(), f.bsp_by_depth.size());
+  for (std::size_t d = 0; d < depth; ++d)
+    fmt::print("{}{}: {}/{}", d % 8 ? "  " : "\n  ", d, d < f.kd_by_depth.size() ? f.kd_by_depth[d] : 0,
+               d < f.bsp_by_depth.size() ? f.bsp_by_depth[d] : 0);
+  fmt::print("\nleaves by triangle count:");
+  for (std::size_t n = 0; n < f.leaf_histogram.size(); ++n)
+    if (f.leaf_histogram[n] && (n < 16 || n + 1 == f.leaf_histogram.size()))
+      fmt::print(" [{}]={}", n, f.leaf_histogram[n]);
+  fmt::print("\n");
+}
+
+void build_bsp_file(const BuildArgs& a, const TriangleSoup& soup) {
+  BspConfig config;
+  config.membership = parse_membership(a.membership);
+  config.threads = a.threads;
+  if (a.paper) config.bsp_max_triangles = SIZE_MAX;
+  BspBuildReport report;
+  BspTree tree;
+  {
+    ProgressBar bar("building bsp", 1000, "permille", ProgressBar::stderr_is_terminal());
+    tree = build_bsp(soup, config, &report, [&](double done, double total) {
+      bar.set(total > 0 ? std::uint64_t(1000.0 * done / total) : 0);
+    });
+  }
+  FlattenReport flat_report;
+  const FlatBspTree flat = flatten_bsp(soup, tree, &flat_report);
+  write_bsp_file_with_flat(a.output, soup, tree, flat);
+  fmt::print("built BSP tree in {:.3f} s ({:.0f} triangles/s), membership {}, exact fallbacks {} of {} filtered side tests\n",
+             report.seconds, double(report.triangles) / std::max(report.seconds, 1e-9), a.membership,
+             report.exact.exact_fallbacks, report.exact.filter_calls);
+  print_bsp_figures(bsp_figures(tree.nodes(), tree.planes(), a.output));
+  const FlatBspStats fs = flat_bsp_stats(flat);
+  fmt::print("flat tree: {} nodes ({} plane, {} kd), {} bytes; wrote {}\n", fs.nodes, fs.plane_nodes, fs.kd_nodes,
+             fs.bytes, a.output);
+}
+
 void run_build(const BuildArgs& a) {
   const auto threads = limit_threads(a.threads);
   const TriangleSoup soup = load_scene(a.scene, a.allow_nonfinite, true);
   if (a.accel == "kd") return build_kd_file(a, soup);
+  if (a.accel == "bsp") return build_bsp_file(a, soup);
   throw UsageError("bsprt build: --accel must be kd or bsp, not '" + a.accel + "'");
 }
 
@@ -57,7 +141,8 @@ void run_stats(const std::string& path) {
     print_kd_stats(kd_tree_stats(tree));
     return;
   }
-  throw InputError(path, "stats: unsupported tree kind");
+  fmt::print("{}: BSP tree for {} triangles, ", path, file.triangle_count());
+  print_bsp_figures(bsp_figures(file.array<BspNode>(kBspNodesTag), file.array<PlaneDef>(kBspPlanesTag), path));
 }
 
 }  // namespace
@@ -67,7 +152,10 @@ void register_build(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("build", "build a tree and write it to a tree file bound to the scene");
   cmd->add_option("SCENE", args->scene, "mesh file or 'default'")->required();
   cmd->add_option("-o,--output", args->output, "tree file to write")->required();
-  cmd->add_option("--accel", args->accel, "kd (SAH kd-tree)")->capture_default_str();
+  cmd->add_option("--accel", args->accel, "kd (SAH kd-tree) or bsp (exact general BSP)")->capture_default_str();
+  cmd->add_option("--membership", args->membership, "bsp: area (default) or closed, see docs/bsp-build.md")
+      ->capture_default_str();
+  cmd->add_flag("--paper", args->paper, "bsp: evaluate face/edge planes at every node (the paper's full, slow build)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
   cmd->callback([args] { run_build(*args); });

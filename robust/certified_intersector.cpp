@@ -145,7 +145,6 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
   if (!is_valid(ray)) return;
   for (const std::uint32_t prim : prims) {
     if (counters) ++counters->triangle_tests;
-    evaluations_.fetch_add(1, std::memory_order_relaxed);
     const auto tri = soup_.corners(prim);
     std::optional<Candidate> c = test_one(ray, tri, fallbacks_);
     if (!c) continue;

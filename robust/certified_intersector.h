@@ -31,15 +31,13 @@ class CertifiedIntersector final : public LeafIntersector {
   void intersect(const Ray& ray, std::span<const std::uint32_t> prims, NearestHit& best,
                  RayCounters* counters) const override;
 
-  /// Interval evaluations that could not decide and fell back to exact rationals.
+  /// Decisions the interval filter could not make, done in exact rationals
+  /// (all threads; rare, so one shared counter costs nothing).
   std::uint64_t exact_fallbacks() const { return fallbacks_.load(std::memory_order_relaxed); }
-  /// All triangle evaluations.
-  std::uint64_t evaluations() const { return evaluations_.load(std::memory_order_relaxed); }
 
  private:
   const TriangleSoup& soup_;
   mutable std::atomic<std::uint64_t> fallbacks_{0};
-  mutable std::atomic<std::uint64_t> evaluations_{0};
 };
 
 /// Brute force with the certified test: every triangle, exact decisions. The

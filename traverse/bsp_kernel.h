@@ -16,6 +16,7 @@
 
 #include "geometry/ray.h"
 #include "traverse/bsp_node.h"
+#include "traverse/leaf_intersector.h"
 #include "traverse/counters.h"
 #include "traverse/simd.h"
 
@@ -52,6 +53,7 @@ struct BspView {
   const BspTriangle* triangles;  ///< parallel to prims
   Box3f bounds;                  ///< root cell
   bool certified;                ///< false: the zero-epsilon variant (per-ray errors 0)
+  const LeafIntersector* exact_leaf = nullptr;  ///< exact-decision leaf test, or null = watertight float
 };
 
 /// Per-ray constants of the traversal, made once per ray by bsp_ray_setup.

@@ -23,15 +23,20 @@ struct StackEntry {
   float tmin, tmax;
 };
 
-/// Tests the triangles of a leaf (ties keep the earlier triangle).
+/// Tests the triangles of a leaf (ties keep the earlier triangle). With an
+/// exact leaf test, `nearest` keeps the exact order and hit mirrors it.
 template <bool kCount>
-inline void intersect_leaf(const BspView& v, const FlatBspNode& n, const WatertightRay& wr, Hit& hit,
-                           RayCounters* c) {
+inline void intersect_leaf(const BspView& v, const FlatBspNode& n, const Ray& ray, const WatertightRay& wr, Hit& hit,
+                           NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
-  if constexpr (kCount) {
-    ++c->leaf_visits;
-    c->triangle_tests += n.prim_count();
+  if constexpr (kCount) ++c->leaf_visits;
+  if (v.exact_leaf) {
+    v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, n.prim_count()), nearest,
+                            kCount ? c : nullptr);
+    hit = nearest.hit;
+    return;
   }
+  if constexpr (kCount) c->triangle_tests += n.prim_count();
   for (std::uint32_t i = first; i < end; ++i) {
     const BspTriangle& t = v.triangles[i];
     intersect_watertight_closest(wr, t.v[0], t.v[1], t.v[2], v.prims[i], hit);
@@ -66,6 +71,7 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
   const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
   if (!rc.live) return hit;
   const WatertightRay wr = watertight_precompute(ray);
+  NearestHit nearest;
   float tmin = rc.tmin, tmax = rc.tmax;
   StackEntry stack[kBspMaxDepth];
   int sp = 0;
@@ -96,7 +102,7 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
       }
       n = &v.nodes[node];
     }
-    if (n->is_leaf()) intersect_leaf<kCount>(v, *n, wr, hit, c);
+    if (n->is_leaf()) intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
     for (;;) {
       if (sp == 0) return hit;
       const StackEntry& e = stack[--sp];
@@ -137,14 +143,15 @@ BspTracer::BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode
 }
 
 namespace {
-BspView make_view(const FlatBspTree& t, const std::vector<BspTriangle>& tris, BspEpsilon mode) {
-  return BspView{t.nodes.data(), t.prims.data(), tris.data(), t.bounds,
-                 mode == BspEpsilon::Certified};
+BspView make_view(const FlatBspTree& t, const std::vector<BspTriangle>& tris, BspEpsilon mode,
+                  const LeafIntersector* exact_leaf) {
+  return BspView{t.nodes.data(), t.prims.data(), tris.data(), t.bounds, mode == BspEpsilon::Certified,
+                 exact_leaf};
 }
 }  // namespace
 
 Hit BspTracer::trace(const Ray& ray, RayCounters* counters) const {
-  const BspView v = make_view(tree_, triangles_, mode_);
+  const BspView v = make_view(tree_, triangles_, mode_, exact_leaf_);
   if (tree_.bounds.empty()) {
     if (counters) ++counters->rays;
     return Hit{};
@@ -161,11 +168,11 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   if (int(detected_isa()) < int(need))
     throw UsageError("packets of " + std::to_string(packet_width) + " rays need " +
                      isa_name(need) + ", this CPU has " + isa_name(detected_isa()));
-  if (need == Isa::Scalar || tree_.bounds.empty()) {
+  if (need == Isa::Scalar || tree_.bounds.empty() || exact_leaf_) {  // exact leaves: single rays
     for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
     return;
   }
-  const BspView v = make_view(tree_, triangles_, mode_);
+  const BspView v = make_view(tree_, triangles_, mode_, exact_leaf_);
   switch (need) {
     case Isa::Sse42:
       detail::bsp_trace_packets_sse42(v, rays.data(), rays.size(), hits.data(), counters);

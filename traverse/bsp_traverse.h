@@ -16,6 +16,7 @@
 
 #include "geometry/triangle_soup.h"
 #include "traverse/bsp_node.h"
+#include "traverse/leaf_intersector.h"
 #include "traverse/tracer.h"
 
 namespace bsprt {
@@ -40,7 +41,14 @@ class BspTracer final : public Tracer {
   /// was built for a scene with another triangle count.
   BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode = BspEpsilon::Certified);
 
-  std::string name() const override { return "bsp"; }
+  std::string name() const override {
+    return exact_leaf_ ? "bsp-certified" : (mode_ == BspEpsilon::Zero ? "bsp-zero-eps" : "bsp");
+  }
+  /// Tests leaves with `exact` (exact decisions, robust/certified_intersector.h)
+  /// instead of the float watertight test; it must outlive the tracer. With
+  /// certified epsilons this makes every decision exact: the nearest hit equals
+  /// the exact reference's. Packets then run as single rays.
+  void set_exact_leaf(const LeafIntersector* exact) { exact_leaf_ = exact; }
   /// Single ray, front to back; counts bsp_node_visits, kd_node_visits,
   /// leaf_visits, triangle_tests and rays when `counters` is non-null.
   Hit trace(const Ray& ray, RayCounters* counters = nullptr) const override;
@@ -59,6 +67,7 @@ class BspTracer final : public Tracer {
  private:
   FlatBspTree tree_;
   BspEpsilon mode_;
+  const LeafIntersector* exact_leaf_ = nullptr;
   std::vector<BspTriangle> triangles_;  ///< triangles_[i] = corners of tree_.prims[i]
 };
 
