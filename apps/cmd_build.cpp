@@ -108,7 +108,9 @@ void build_bsp_file(const BuildArgs& a, const TriangleSoup& soup) {
   }
   FlattenReport flat_report;
   const FlatBspTree flat = flatten_bsp(soup, tree, &flat_report);
-  write_bsp_file_with_flat(a.output, soup, tree, flat);
+  const BspReportRecord record{report.seconds, report.exact.filter_calls, report.exact.symbolic,
+                               report.exact.exact_fallbacks, report.exact.exact_points};
+  write_bsp_file_with_flat(a.output, soup, tree, flat, &record);
   fmt::print("built BSP tree in {:.3f} s ({:.0f} triangles/s), membership {}, exact fallbacks {} of {} filtered side tests\n",
              report.seconds, double(report.triangles) / std::max(report.seconds, 1e-9), a.membership,
              report.exact.exact_fallbacks, report.exact.filter_calls);
@@ -142,6 +144,12 @@ void run_stats(const std::string& path) {
     return;
   }
   fmt::print("{}: BSP tree for {} triangles, ", path, file.triangle_count());
+  const std::vector<BspReportRecord> rec = file.has_section(kBspReportTag)
+                                               ? file.array<BspReportRecord>(kBspReportTag)
+                                               : std::vector<BspReportRecord>{};
+  if (rec.size() == 1)
+    fmt::print("built in {:.3f} s, exact fallbacks {} of {} filtered side tests ({} symbolic), ", rec[0].seconds,
+               rec[0].exact_fallbacks, rec[0].filter_calls, rec[0].symbolic);
   print_bsp_figures(bsp_figures(file.array<BspNode>(kBspNodesTag), file.array<PlaneDef>(kBspPlanesTag), path));
 }
 

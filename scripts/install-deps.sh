@@ -11,6 +11,7 @@ packages=(
   libembree-dev                                     # Embree 3: benchmark peer and test oracle
   catch2 libbenchmark-dev                           # tests (Catch2 v2) and micro-benchmarks
   clang libclang-rt-dev                             # libFuzzer harnesses and sanitizers
+  gnuplot-nox                                       # plots in docs/performance.md (scripts/docs.sh)
 )
 
 missing=()

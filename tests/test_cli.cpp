@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "geometry/hit_compare.h"
 #include "geometry/ray_io.h"
 #include "test_util.h"
 
@@ -117,4 +118,48 @@ TEST_CASE("info reports counts of a shared mesh", "[cli]") {
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK(r.output.find("triangles   968") != std::string::npos);
+}
+
+TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
+  const std::string scene = scene_path("suzanne.obj");
+  const std::string tree = temp_path("cli_suzanne.bsp"), kd = temp_path("cli_suzanne.kd");
+  const Run b = bsprt_cli("build " + scene + " -o " + tree + " --accel bsp --threads 2");
+  INFO(b.output);
+  REQUIRE(b.status == 0);
+  CHECK(b.output.find("BSP (face/edge) splits") != std::string::npos);
+  const Run st = bsprt_cli("stats " + tree);
+  REQUIRE(st.status == 0);
+  CHECK(st.output.find("exact fallbacks") != std::string::npos);
+  CHECK(st.output.find("leaves by triangle count") != std::string::npos);
+  REQUIRE(bsprt_cli("build " + scene + " -o " + kd + " --accel kd").status == 0);
+
+  const std::string rays = temp_path("cli_suzanne_vertex.rays");
+  REQUIRE(bsprt_cli("gen-rays " + scene + " --kind vertex -n 3000 --seed 3 -o " + rays).status == 0);
+  auto trace = [&](const std::string& accel, const std::string& extra) {
+    const std::string hits = temp_path("cli_suzanne_" + accel + ".hits");
+    const Run r = bsprt_cli("trace " + scene + " " + rays + " -o " + hits + " --accel " + accel + " " + extra);
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    return read_hits(hits);
+  };
+  const auto exact = trace("exact", ""), certified = trace("bsp-certified", "--tree " + tree);
+  const auto brute = trace("brute", ""), bsp = trace("bsp", "--tree " + tree), kd_hits = trace("kd", "--tree " + kd);
+  // The certified BSP equals the exact reference ray by ray.
+  const HitComparison c = compare_hits(exact, certified);
+  CHECK(c.agrees());
+  CHECK(c.tie == 0);
+  CHECK(c.max_t_ulps == 0);
+  // The float BSP and kd-tree equal brute force (same watertight test) up to ties.
+  CHECK(compare_hits(brute, bsp).agrees());
+  CHECK(compare_hits(brute, kd_hits).agrees());
+  CHECK(bsprt_cli("compare " + temp_path("cli_suzanne_exact.hits") + " " + temp_path("cli_suzanne_bsp-certified.hits")).status == 0);
+
+  // A tree is bound to its scene and kind.
+  const Run wrong = bsprt_cli("trace " + scene_path("cube.obj") + " " + rays + " -o " + temp_path("x.hits") +
+                              " --accel bsp --tree " + tree);
+  CHECK(wrong.status == 1);
+  CHECK(wrong.output.find(tree) != std::string::npos);
+  const Run kind = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp --tree " + kd);
+  CHECK(kind.status == 1);
+  CHECK(kind.output.find("kd-tree") != std::string::npos);
 }
