@@ -64,6 +64,7 @@ struct BenchRow {
   double mrays_single = 0.0;      ///< single rays, all threads
   double mrays_packet = 0.0;      ///< packets of `packet_width` (0 when the mode has none)
   int packet_width = 1;           ///< widest ISA's width; 1 for certified modes
+  // Work per ray is counted on the error subset (all timed rays when there is none).
   double kd_visits = 0.0;         ///< kd node visits per ray
   double bsp_visits = 0.0;        ///< general-plane node visits per ray
   double leaf_visits = 0.0;       ///< leaves per ray

@@ -48,6 +48,9 @@ void register_info(CLI::App& app);
 void register_gen_rays(CLI::App& app);
 void register_compare(CLI::App& app);
 void register_build(CLI::App& app);  // build and stats
+void register_bench(CLI::App& app);
+void register_gen(CLI::App& app);  // stiff scenes and rays
+void register_verify(CLI::App& app);  // exact certificate of a BSP tree file
 
 /// Thrown by `compare` when the files disagree: exit code 1, nothing more printed.
 struct CompareFailed {};

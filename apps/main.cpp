@@ -17,6 +17,9 @@ int main(int argc, char** argv) {
   bsprt::cli::register_gen_rays(app);
   bsprt::cli::register_compare(app);
   bsprt::cli::register_build(app);
+  bsprt::cli::register_bench(app);
+  bsprt::cli::register_gen(app);
+  bsprt::cli::register_verify(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

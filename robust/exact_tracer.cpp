@@ -42,6 +42,11 @@ struct Candidate {
 template <typename Query>
 std::optional<Candidate> exact_hit(const Epeck::Triangle_3& tri, const Query& query, const Epeck::Point_3& o,
                                    const Epeck::Vector_3& d, const FT& tnear, const std::optional<FT>& tfar) {
+  // A line parallel to the plane misses, also where it touches the triangle
+  // at a single corner or edge point in its plane (CGAL reports a Point_3 then).
+  // Regression test "exact reference: a ray in a triangle's plane touching a corner misses".
+  const Epeck::Vector_3 normal = CGAL::cross_product(tri[1] - tri[0], tri[2] - tri[0]);
+  if (CGAL::scalar_product(normal, d) == 0) return std::nullopt;
   const auto hit = CGAL::intersection(query, tri);
   if (!hit) return std::nullopt;
   const auto* p = boost::get<Epeck::Point_3>(&*hit);

@@ -1,0 +1,131 @@
+/// \file bench_report.cpp
+/// Markdown, CSV and JSON views of a BenchResult.
+#include "apps/bench_report.h"
+
+#include <fmt/core.h>
+
+namespace bsprt {
+namespace {
+
+/// Leaks and lost hits per million rays: (lost + farther) / rays · 1e6.
+double leaks_per_million(const BenchRow& r) {
+  return r.error_rays ? double(r.error.lost + r.error.farther) / double(r.error_rays) * 1e6 : 0.0;
+}
+
+/// Wall nanoseconds per ray, single rays, all threads.
+double ns_per_ray(const BenchRow& r) { return r.mrays_single > 0 ? 1e3 / r.mrays_single : 0.0; }
+
+std::string ratio_cell(double x) { return x > 0 ? fmt::format("{:.2f}", x) : std::string("–"); }
+
+std::string md_table_header() {
+  return "| mode | build s | Mrays/s single | Mrays/s packet | vs kd | vs embree | kd+bsp nodes/ray | tri tests/ray "
+         "| MB | error rays | lost | extra | farther (leaks) | nearer | max t ulps | median t ulps |\n"
+         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+}
+
+std::string md_row(const BenchResult& res, const BenchRow& r) {
+  const bool err = r.error_rays > 0;
+  const auto cnt = [&](std::uint64_t v) { return err ? fmt::format("{}", v) : std::string("–"); };
+  const bool counted = r.kd_visits + r.bsp_visits + r.triangle_tests > 0;  // Embree has no counters
+  return fmt::format("| {} | {:.3f} | {:.2f} | {} | {} | {} | {} | {} | {:.1f} | {} | {} | {} | {} | {} | {} | {} |\n",
+                     r.mode, r.build_seconds, r.mrays_single,
+                     r.packet_width > 1 ? fmt::format("{:.2f} ({})", r.mrays_packet, r.packet_width) : "single only",
+                     ratio_cell(bench_speed_ratio(res, r, "kd")), ratio_cell(bench_speed_ratio(res, r, "embree")),
+                     counted ? fmt::format("{:.1f}", r.kd_visits + r.bsp_visits) : "–",
+                     counted ? fmt::format("{:.2f}", r.triangle_tests) : "–", double(r.memory_bytes) / 1e6,
+                     err ? fmt::format("{}", r.error_rays) : "–", cnt(r.error.lost), cnt(r.error.extra),
+                     cnt(r.error.farther), cnt(r.error.nearer), err ? fmt::format("{:.0f}", r.error.max_t_ulps) : "–",
+                     err ? fmt::format("{:.1f}", r.median_t_ulps) : "–");
+}
+
+/// Rows grouped by (scene, ray set) in first-seen order.
+std::vector<std::vector<const BenchRow*>> groups(const BenchResult& res) {
+  std::vector<std::vector<const BenchRow*>> out;
+  for (const BenchRow& r : res.rows) {
+    if (out.empty() || out.back().front()->scene != r.scene || out.back().front()->ray_set != r.ray_set)
+      out.emplace_back();
+    out.back().push_back(&r);
+  }
+  return out;
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) out += c;
+  }
+  return out + "\"";
+}
+
+std::string json_row(const BenchResult& res, const BenchRow& r) {
+  return fmt::format(
+      "{{\"scene\": {}, \"triangles\": {}, \"rays\": {}, \"mode\": {}, \"ray_count\": {}, \"build_seconds\": {:.6f}, "
+      "\"mrays_single\": {:.4f}, \"mrays_packet\": {:.4f}, \"packet_width\": {}, \"kd_visits\": {:.4f}, "
+      "\"bsp_visits\": {:.4f}, \"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}, \"memory_bytes\": {}, "
+      "\"hits\": {}, \"error_rays\": {}, \"lost\": {}, \"extra\": {}, \"farther\": {}, \"nearer\": {}, \"tie\": {}, "
+      "\"max_t_ulps\": {:.1f}, \"median_t_ulps\": {:.1f}, \"leaks_per_million\": {:.2f}, \"speed_vs_kd\": {:.4f}, "
+      "\"speed_vs_embree\": {:.4f}}}",
+      json_string(r.scene), r.triangles, json_string(r.ray_set), json_string(r.mode), r.rays, r.build_seconds,
+      r.mrays_single, r.mrays_packet, r.packet_width, r.kd_visits, r.bsp_visits, r.leaf_visits, r.triangle_tests,
+      r.memory_bytes, r.hits, r.error_rays, r.error.lost, r.error.extra, r.error.farther, r.error.nearer, r.error.tie,
+      r.error.max_t_ulps, r.median_t_ulps, leaks_per_million(r), bench_speed_ratio(res, r, "kd"),
+      bench_speed_ratio(res, r, "embree"));
+}
+
+}  // namespace
+
+double bench_speed_ratio(const BenchResult& result, const BenchRow& row, const std::string& base) {
+  for (const BenchRow& b : result.rows)
+    if (b.scene == row.scene && b.ray_set == row.ray_set && b.mode == base && b.mrays_single > 0 && b.rays == row.rays)
+      return row.mrays_single / b.mrays_single;
+  return 0.0;
+}
+
+std::vector<std::string> bench_csv_columns() {
+  return {"scene",        "triangles",     "rays",        "mode",           "ray_count",     "build_seconds",
+          "mrays_single", "mrays_packet",  "packet_width", "kd_visits",     "bsp_visits",    "leaf_visits",
+          "triangle_tests", "memory_bytes", "hits",        "error_rays",    "lost",          "extra",
+          "farther",      "nearer",        "tie",         "max_t_ulps",     "median_t_ulps", "leaks_per_million",
+          "ns_per_ray",   "speed_vs_kd",   "speed_vs_embree"};
+}
+
+std::string bench_csv(const BenchResult& res) {
+  std::string out;
+  for (const std::string& c : bench_csv_columns()) out += (out.empty() ? "" : ",") + c;
+  out += "\n";
+  for (const BenchRow& r : res.rows)
+    out += fmt::format("{},{},{},{},{},{:.6f},{:.4f},{:.4f},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{:.1f},"
+                       "{:.1f},{:.2f},{:.3f},{:.4f},{:.4f}\n",
+                       r.scene, r.triangles, r.ray_set, r.mode, r.rays, r.build_seconds, r.mrays_single, r.mrays_packet,
+                       r.packet_width, r.kd_visits, r.bsp_visits, r.leaf_visits, r.triangle_tests, r.memory_bytes, r.hits,
+                       r.error_rays, r.error.lost, r.error.extra, r.error.farther, r.error.nearer, r.error.tie,
+                       r.error.max_t_ulps, r.median_t_ulps, leaks_per_million(r), ns_per_ray(r),
+                       bench_speed_ratio(res, r, "kd"), bench_speed_ratio(res, r, "embree"));
+  return out;
+}
+
+std::string bench_json(const BenchResult& res) {
+  std::string out = fmt::format("{{\"threads\": {}, \"isa\": {}, \"packet_width\": {}, \"notes\": [", res.threads,
+                                json_string(res.isa), res.packet_width);
+  for (std::size_t i = 0; i < res.notes.size(); ++i) out += (i ? ", " : "") + json_string(res.notes[i]);
+  out += "],\n\"rows\": [\n";
+  for (std::size_t i = 0; i < res.rows.size(); ++i) out += (i ? ",\n" : "") + json_row(res, res.rows[i]);
+  return out + "\n]}\n";
+}
+
+std::string bench_markdown(const BenchResult& res) {
+  std::string out;
+  for (const auto& g : groups(res)) {
+    const BenchRow& f = *g.front();
+    out += fmt::format("\n#### {} ({} triangles), {} rays: {} timed, {} checked against the exact reference\n\n",
+                       f.scene, f.triangles, f.ray_set, f.rays, f.error_rays);
+    out += md_table_header();
+    for (const BenchRow* r : g) out += md_row(res, *r);
+  }
+  for (const std::string& n : res.notes) out += "\n- " + n;
+  if (!res.notes.empty()) out += "\n";
+  return out;
+}
+
+}  // namespace bsprt

@@ -1,0 +1,321 @@
+/// \file bench_runner.cpp
+/// run_bench: one process, the same rays and threads for every mode; errors
+/// against ExactTracer on a strided subset of each ray set.
+#include "apps/bench_runner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <numbers>
+#include <random>
+
+#include <fmt/core.h>
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/combinable.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include "builder/accel_factory.h"
+#include "builder/bsp_build.h"
+#include "builder/bsp_flat_io.h"
+#include "builder/bsp_flatten.h"
+#include "geometry/camera.h"
+#include "geometry/default_scene.h"
+#include "geometry/error.h"
+#include "geometry/load_mesh.h"
+#include "geometry/ray_gen.h"
+#include "robust/exact_tracer.h"
+#include "traverse/cpu_features.h"
+
+namespace bsprt {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// Modes whose speed is measured on the error subset only (too slow for more).
+bool is_slow_mode(const std::string& mode) { return mode == "exact" || mode == "brute" || mode == "brute-certified"; }
+
+bool is_bsp_mode(const std::string& mode) { return mode.rfind("bsp", 0) == 0; }
+
+/// Primary rays in 8x8 pixel tiles (row-major inside a tile), so consecutive
+/// rays, and hence packets, are coherent (as bench/bench_kd.cpp).
+std::vector<Ray> tiled_primary_rays(const TriangleSoup& soup, std::size_t n) {
+  const int width = std::max(8, int(std::lround(std::sqrt(double(n) * 4.0 / 3.0))));
+  const int height = std::max(8, int(std::lround(double(n) / width)));
+  const CameraRays cam(frame_bounds(soup.bounds()), width, height);
+  std::vector<Ray> rays;
+  rays.reserve(std::size_t(width) * std::size_t(height));
+  for (int ty = 0; ty < height; ty += 8)
+    for (int tx = 0; tx < width; tx += 8)
+      for (int y = ty; y < std::min(ty + 8, height); ++y)
+        for (int x = tx; x < std::min(tx + 8, width); ++x) rays.push_back(cam.ray(x, y));
+  return rays;
+}
+
+/// Rays from origins uniform in `ball` shrunk to half its radius, directions
+/// uniform on the sphere: on a closed surface around the ball, every ray hits.
+std::vector<Ray> inside_rays(Vec3f center, float radius, std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Ray> rays(n);
+  for (Ray& r : rays) {
+    Vec3f p;
+    do p = {u(rng), u(rng), u(rng)};
+    while (dot(p, p) > 1.0f);
+    r.org = center + p * (0.5f * radius);
+    const float z = u(rng), phi = std::numbers::pi_v<float> * u(rng);
+    const float s = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    r.dir = {s * std::cos(phi), s * std::sin(phi), z};
+  }
+  return rays;
+}
+
+/// The ray set named `name` for `scene`, or nothing when it does not apply.
+std::optional<std::vector<Ray>> make_ray_set(const std::string& name, const BenchScene& scene, std::size_t n,
+                                             std::uint64_t seed) {
+  if (name == "primary") return tiled_primary_rays(scene.soup, n);
+  if (name == "inside") {
+    if (!scene.inside_ball) return std::nullopt;
+    return inside_rays(scene.inside_ball->first, scene.inside_ball->second, n, seed);
+  }
+  return make_rays(parse_ray_set(name), scene.soup, n, seed);
+}
+
+/// Every `stride`-th ray, so the subset spans the whole set (the whole image).
+std::vector<Ray> strided_subset(const std::vector<Ray>& rays, std::size_t n) {
+  if (n >= rays.size()) return rays;
+  std::vector<Ray> out;
+  out.reserve(n);
+  const double stride = double(rays.size()) / double(n);
+  for (std::size_t i = 0; i < n; ++i) out.push_back(rays[std::size_t(double(i) * stride)]);
+  return out;
+}
+
+/// Traces all rays with `width`-wide packets over blocks of 1024 on all
+/// threads of the current arena; returns seconds of the fastest of `runs`.
+double time_trace(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int width,
+                  int runs) {
+  hits.assign(rays.size(), Hit{});
+  double best = 1e30;
+  for (int r = 0; r < std::max(1, runs); ++r) {
+    const auto t0 = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& range) {
+      const std::size_t n = range.end() - range.begin();
+      tracer.trace_batch(std::span<const Ray>(rays.data() + range.begin(), n),
+                         std::span<Hit>(hits.data() + range.begin(), n), width, nullptr);
+    });
+    best = std::min(best, seconds_since(t0));
+  }
+  return best;
+}
+
+/// Work per ray, counted in a separate single-ray pass (counters cost time).
+RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays) {
+  tbb::combinable<RayCounters> local;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) tracer.trace(rays[i], &local.local());
+  });
+  RayCounters sum;
+  local.combine_each([&](const RayCounters& c) { sum += c; });
+  return sum;
+}
+
+/// A built accelerator with its build time.
+struct BuiltMode {
+  std::string mode;
+  std::unique_ptr<Tracer> tracer;
+  double build_seconds = 0.0;
+};
+
+/// Builds the exact BSP tree once, flattens it and writes it to a temporary
+/// tree file, so every BSP mode loads the same tree. Returns build seconds.
+double build_bsp_once(const TriangleSoup& soup, int threads, const std::filesystem::path& file) {
+  const auto t0 = Clock::now();
+  BspConfig config;
+  config.threads = threads;
+  const BspTree exact = build_bsp(soup, config);
+  const FlatBspTree flat = flatten_bsp(soup, exact);
+  const double seconds = seconds_since(t0);
+  write_bsp_file_with_flat(file.string(), soup, exact, flat);
+  return seconds;
+}
+
+std::filesystem::path temp_tree_path() {
+  std::random_device rd;
+  return std::filesystem::temp_directory_path() / fmt::format("bsprt-bench-{:016x}.tree",
+                                                              (std::uint64_t(rd()) << 32) ^ rd());
+}
+
+/// Builds every mode for one scene (BSP modes share one build).
+std::vector<BuiltMode> build_modes(const BenchScene& scene, const BenchOptions& o, int threads,
+                                   const std::function<void(const std::string&)>& step) {
+  std::vector<BuiltMode> built;
+  std::filesystem::path tree_file;
+  double bsp_seconds = 0.0;
+  struct Cleanup {
+    std::filesystem::path* p;
+    ~Cleanup() {
+      std::error_code ec;
+      if (!p->empty()) std::filesystem::remove(*p, ec);
+    }
+  } cleanup{&tree_file};
+  for (const std::string& mode : o.modes) {
+    step(fmt::format("{}: building {}", scene.name, mode));
+    AccelOptions options;
+    options.threads = threads;
+    double seconds = 0.0;
+    if (is_bsp_mode(mode)) {
+      if (tree_file.empty()) {
+        tree_file = temp_tree_path();
+        bsp_seconds = build_bsp_once(scene.soup, threads, tree_file);
+      }
+      options.tree_path = tree_file.string();
+      seconds = bsp_seconds;
+    }
+    const auto t0 = Clock::now();
+    std::unique_ptr<Tracer> tracer = make_tracer(mode, scene.soup, options);
+    if (!is_bsp_mode(mode)) seconds = seconds_since(t0);
+    built.push_back({mode, std::move(tracer), seconds});
+  }
+  return built;
+}
+
+/// Exact reference hits of `rays` (parallel; the slow part of the run).
+std::vector<Hit> exact_hits(const TriangleSoup& soup, const std::vector<Ray>& rays) {
+  const ExactTracer exact(soup);
+  std::vector<Hit> hits(rays.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 64), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) hits[i] = exact.trace(rays[i]);
+  });
+  return hits;
+}
+
+/// Measures one built mode on one ray set (timed rays, error subset, reference).
+BenchRow measure_mode(const BuiltMode& m, const std::vector<Ray>& rays, const std::vector<Ray>& subset,
+                      const std::vector<Hit>& reference, const BenchOptions& o, int isa_width) {
+  BenchRow row;
+  row.mode = m.mode;
+  row.build_seconds = m.build_seconds;
+  row.memory_bytes = m.tracer->memory_bytes();
+  const std::vector<Ray>& timed = is_slow_mode(m.mode) && !subset.empty() ? subset : rays;
+  row.rays = timed.size();
+  std::vector<Hit> hits;
+  const int runs = bench_mode_is_certified(m.mode) ? 1 : o.runs;  // slow modes: one pass
+  row.mrays_single = double(timed.size()) / time_trace(*m.tracer, timed, hits, 1, runs) * 1e-6;
+  row.hits = std::size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.hit(); }));
+  row.packet_width = bench_mode_is_certified(m.mode) ? 1 : isa_width;
+  if (row.packet_width > 1)
+    row.mrays_packet = double(timed.size()) / time_trace(*m.tracer, timed, hits, row.packet_width, o.runs) * 1e-6;
+  const RayCounters c = count_work(*m.tracer, subset.empty() ? timed : subset);
+  const double n = double(std::max<std::uint64_t>(1, c.rays ? c.rays : (subset.empty() ? timed : subset).size()));
+  row.kd_visits = double(c.kd_node_visits) / n;
+  row.bsp_visits = double(c.bsp_node_visits) / n;
+  row.leaf_visits = double(c.leaf_visits) / n;
+  row.triangle_tests = double(c.triangle_tests) / n;
+  if (!subset.empty()) {
+    std::vector<Hit> tested;
+    time_trace(*m.tracer, subset, tested, 1, 1);
+    row.error_rays = subset.size();
+    row.error = compare_hits(reference, tested);
+    row.median_t_ulps = median_t_ulps(reference, tested);
+  }
+  return row;
+}
+
+/// All ray sets of one scene.
+void bench_scene(const BenchScene& scene, const BenchOptions& o, int threads, int isa_width, BenchResult& result,
+                 const std::function<void(const std::string&)>& step) {
+  const std::vector<BuiltMode> built = build_modes(scene, o, threads, step);
+  for (const std::string& set : o.ray_sets) {
+    const auto rays = make_ray_set(set, scene, o.count, o.seed);
+    if (!rays) {
+      result.notes.push_back(fmt::format("{}: ray set '{}' skipped (no known inside region)", scene.name, set));
+      for (std::size_t i = 0; i < built.size() + 1; ++i) step(fmt::format("{}: {} skipped", scene.name, set));
+      continue;
+    }
+    const std::vector<Ray> subset = o.error_count ? strided_subset(*rays, o.error_count) : std::vector<Ray>{};
+    step(fmt::format("{}: exact reference on {} {} rays", scene.name, subset.size(), set));
+    const std::vector<Hit> reference = subset.empty() ? std::vector<Hit>{} : exact_hits(scene.soup, subset);
+    for (const BuiltMode& m : built) {
+      step(fmt::format("{}: {} rays, {}", scene.name, set, m.mode));
+      BenchRow row = measure_mode(m, *rays, subset, reference, o, isa_width);
+      row.scene = scene.name;
+      row.triangles = scene.soup.size();
+      row.ray_set = set;
+      result.rows.push_back(std::move(row));
+    }
+  }
+}
+
+void check_options(const BenchOptions& o) {
+  const std::vector<std::string> names = accel_names();
+  for (const std::string& m : o.modes)
+    if (std::find(names.begin(), names.end(), m) == names.end())
+      throw UsageError("bench: unknown mode '" + m + "'");
+  for (const std::string& s : o.ray_sets)
+    if (s != "inside") (void)parse_ray_set(s);
+  if (o.count == 0) throw UsageError("bench: --count must be positive");
+}
+
+}  // namespace
+
+bool bench_mode_is_certified(const std::string& mode) {
+  return mode == "bsp-certified" || mode == "exact" || mode == "brute-certified";
+}
+
+double median_t_ulps(const std::vector<Hit>& reference, const std::vector<Hit>& tested) {
+  std::vector<double> d;
+  for (std::size_t i = 0; i < std::min(reference.size(), tested.size()); ++i)
+    if (reference[i].hit() && tested[i].hit()) d.push_back(ulp_distance(reference[i].t, tested[i].t));
+  if (d.empty()) return 0.0;
+  std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+BenchScene load_bench_scene(const std::string& spec) {
+  BenchScene scene;
+  if (spec.empty() || spec == "default") {
+    scene.name = "default";
+    scene.soup = make_default_scene();
+  } else if (spec.rfind("icosphere:", 0) == 0) {
+    const std::string levels = spec.substr(10);
+    if (levels.empty() || levels.size() > 1 || levels[0] < '0' || levels[0] > '9')
+      throw UsageError("bench: expected icosphere:L with L in 0..9, not '" + spec + "'");
+    const int level = levels[0] - '0';
+    scene.name = "icosphere-" + levels;
+    scene.soup = make_icosphere({0.0f, 0.0f, 0.0f}, 1.0f, level);
+    // The icosahedron's inradius is 0.79 of its circumradius; subdividing only grows it.
+    scene.inside_ball = std::make_pair(Vec3f{0.0f, 0.0f, 0.0f}, 0.75f);
+  } else {
+    scene.name = std::filesystem::path(spec).stem().string();
+    scene.soup = load_mesh(spec);
+  }
+  return scene;
+}
+
+BenchResult run_bench(const std::vector<BenchScene>& scenes, const BenchOptions& o) {
+  check_options(o);
+  BenchResult result;
+  const Isa isa = detected_isa();
+  result.isa = isa_name(isa);
+  result.packet_width = isa_width(isa);
+  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
+  result.threads = arena.max_concurrency();
+  const std::size_t total = scenes.size() * (o.modes.size() + o.ray_sets.size() * (o.modes.size() + 1));
+  std::size_t done = 0;
+  const auto step = [&](const std::string& what) {
+    if (o.progress) o.progress(what, done, total);
+    ++done;
+  };
+  arena.execute([&] {
+    for (const BenchScene& scene : scenes) bench_scene(scene, o, result.threads, result.packet_width, result, step);
+  });
+  if (o.progress) o.progress("done", total, total);
+  return result;
+}
+
+}  // namespace bsprt

@@ -1,0 +1,107 @@
+// `bsprt bench SCENE... [--rays ...] [--modes ...] [--count N] [--error-count M]
+// [--threads T] [-o DIR]`: every mode on the same rays and threads in one
+// process; speed, work, memory and error against the exact reference. Writes
+// DIR/PREFIX.md, .csv and .json and prints a summary with ratios vs kd and
+// vs Embree (robust). The work is in apps/bench_runner.h.
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "apps/bench_report.h"
+#include "apps/bench_runner.h"
+#include "apps/cli_common.h"
+#include "apps/progress.h"
+#include "geometry/error.h"
+
+namespace bsprt::cli {
+namespace {
+
+struct BenchArgs {
+  std::vector<std::string> scenes;
+  std::vector<std::string> rays = {"primary", "random", "vertex", "edge"};
+  std::vector<std::string> modes = {"kd", "bsp", "bsp-zero-eps", "bsp-certified", "embree", "embree-fast"};
+  std::size_t count = 262144;
+  std::size_t error_count = 20000;
+  int threads = 0;
+  int runs = 2;
+  std::uint64_t seed = 1;
+  std::string output = "bench-out";
+  std::string prefix = "bench";
+};
+
+void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  if (!f) throw InputError(path.string(), "cannot write");
+}
+
+/// The summary printed on stdout: one line per row with the ratios.
+void print_summary(const BenchResult& r) {
+  fmt::print("bench: {} threads, packets of {} ({})\n", r.threads, r.packet_width, r.isa);
+  fmt::print("{:<16} {:<8} {:<14} {:>9} {:>10} {:>10} {:>7} {:>9} {:>8} {:>8} {:>8}\n", "scene", "rays", "mode",
+             "build s", "Mrays/s", "packet", "vs kd", "vs embree", "lost", "farther", "extra");
+  for (const BenchRow& row : r.rows) {
+    const double vk = bench_speed_ratio(r, row, "kd"), ve = bench_speed_ratio(r, row, "embree");
+    fmt::print("{:<16} {:<8} {:<14} {:>9.3f} {:>10.2f} {:>10} {:>7} {:>9} {:>8} {:>8} {:>8}\n", row.scene, row.ray_set,
+               row.mode, row.build_seconds, row.mrays_single,
+               row.packet_width > 1 ? fmt::format("{:.2f}", row.mrays_packet) : "-",
+               vk > 0 ? fmt::format("{:.2f}", vk) : "-", ve > 0 ? fmt::format("{:.2f}", ve) : "-",
+               row.error_rays ? fmt::format("{}", row.error.lost) : "-",
+               row.error_rays ? fmt::format("{}", row.error.farther) : "-",
+               row.error_rays ? fmt::format("{}", row.error.extra) : "-");
+  }
+  for (const std::string& n : r.notes) fmt::print("note: {}\n", n);
+}
+
+void run(const BenchArgs& a) {
+  const auto cap = limit_threads(a.threads);
+  std::vector<BenchScene> scenes;
+  for (const std::string& s : a.scenes) {
+    scenes.push_back(load_bench_scene(s));
+    fmt::print(stderr, "bench: scene {} ({} triangles)\n", scenes.back().name, scenes.back().soup.size());
+  }
+  BenchOptions o;
+  o.ray_sets = a.rays, o.modes = a.modes, o.count = a.count, o.error_count = a.error_count;
+  o.threads = a.threads, o.runs = a.runs, o.seed = a.seed;
+  std::unique_ptr<ProgressBar> bar;
+  o.progress = [&](const std::string&, std::size_t done, std::size_t total) {
+    if (!bar) bar = std::make_unique<ProgressBar>("bench", total, "steps", ProgressBar::stderr_is_terminal());
+    bar->set(done);
+  };
+  const BenchResult result = run_bench(scenes, o);
+  if (bar) bar->finish();
+  const std::filesystem::path dir(a.output);
+  std::filesystem::create_directories(dir);
+  write_file(dir / (a.prefix + ".md"), bench_markdown(result));
+  write_file(dir / (a.prefix + ".csv"), bench_csv(result));
+  write_file(dir / (a.prefix + ".json"), bench_json(result));
+  print_summary(result);
+  fmt::print("wrote {0}.md, {0}.csv, {0}.json\n", (dir / a.prefix).string());
+}
+
+}  // namespace
+
+void register_bench(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "benchmark modes on the same rays: speed, work, memory and error against the exact reference");
+  cmd->add_option("SCENE", args->scenes, "mesh files, 'default', or icosphere:L (generated, 20*4^L triangles)")
+      ->required();
+  cmd->add_option("--rays", args->rays, "ray sets: primary, random, vertex, edge, inside (icospheres only)")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--modes", args->modes, "accelerators (see --accel of trace)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--count", args->count, "rays per set for speed and counters")->capture_default_str();
+  cmd->add_option("--error-count", args->error_count, "rays per set checked against the exact reference (0 = none)")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads, "worker threads for every mode (0 = all cores)")->capture_default_str();
+  cmd->add_option("--runs", args->runs, "timing passes; the fastest counts")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "ray-set seed")->capture_default_str();
+  cmd->add_option("-o,--output", args->output, "directory for PREFIX.md, .csv, .json")->capture_default_str();
+  cmd->add_option("--prefix", args->prefix, "base name of the output files")->capture_default_str();
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace bsprt::cli

@@ -1,0 +1,110 @@
+#pragma once
+/// \file tree_file.h
+/// The container every tree file uses (kd and BSP): a versioned header, tagged
+/// sections, a CRC-32 over everything after the header's checksum field, and a
+/// fingerprint of the scene's triangle data so a tree cannot be used with
+/// another scene. Layout (little-endian):
+///
+///   offset  size  field
+///   0       8     magic "BSPRTREE"
+///   8       4     version (kTreeFileVersion)
+///   12      4     kind (TreeKind)
+///   16      8     scene fingerprint (scene_fingerprint)
+///   24      8     triangle count of the scene
+///   32      4     section count S
+///   36      4     CRC-32 of bytes [40, end)
+///   40      S x { uint32 tag; uint32 reserved; uint64 size; size bytes; pad to 8 }
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <map>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "geometry/error.h"
+#include "geometry/triangle_soup.h"
+
+namespace bsprt {
+
+inline constexpr std::uint32_t kTreeFileVersion = 1;
+
+/// A section tag from four characters, e.g. tree_tag("KNOD") (first char in the lowest byte).
+constexpr std::uint32_t tree_tag(const char (&s)[5]) {
+  return std::uint32_t(std::uint8_t(s[0])) | std::uint32_t(std::uint8_t(s[1])) << 8 |
+         std::uint32_t(std::uint8_t(s[2])) << 16 | std::uint32_t(std::uint8_t(s[3])) << 24;
+}
+/// The four characters of a tag, for messages.
+std::string tree_tag_name(std::uint32_t tag);
+
+/// What a tree file holds.
+enum class TreeKind : std::uint32_t { Kd = 1, Bsp = 2 };
+
+/// A 64-bit fingerprint of the triangle data (vertex coordinates of every
+/// triangle's corners, in triangle order); equal soups give equal fingerprints.
+std::uint64_t scene_fingerprint(const TriangleSoup& soup);
+
+/// Collects sections and writes them as one tree file.
+class TreeFileWriter {
+ public:
+  TreeFileWriter(TreeKind kind, const TriangleSoup& soup);
+  /// Adds a section; tags must be unique within a file.
+  void add_section(std::uint32_t tag, std::span<const std::byte> bytes);
+  template <typename T>
+  void add_array(std::uint32_t tag, const std::vector<T>& v) {
+    add_section(tag, std::as_bytes(std::span<const T>(v)));
+  }
+  /// Writes the file; throws InputError when it cannot be written.
+  void write(const std::string& path) const;
+
+ private:
+  TreeKind kind_;
+  std::uint64_t fingerprint_;
+  std::uint64_t triangle_count_;
+  std::map<std::uint32_t, std::vector<std::byte>> sections_;
+};
+
+/// Reads and checks a tree file: magic, version, CRC, sizes. Throws InputError
+/// naming the file and the problem (corrupt, truncated, wrong version, ...).
+class TreeFileReader {
+ public:
+  explicit TreeFileReader(const std::string& path);
+  TreeKind kind() const { return kind_; }
+  /// Triangle count of the scene the tree was built for.
+  std::uint64_t triangle_count() const { return triangle_count_; }
+  const std::string& path() const { return path_; }
+  /// Throws InputError unless the file was built for this scene (fingerprint
+  /// and triangle count).
+  void check_scene(const TriangleSoup& soup) const;
+  /// The bytes of a section; throws InputError if it is missing.
+  std::span<const std::byte> section(std::uint32_t tag) const;
+  /// True when the file has a section with this tag.
+  bool has_section(std::uint32_t tag) const { return sections_.count(tag) != 0; }
+  /// A section as an array of T; throws InputError if its size is not a
+  /// multiple of sizeof(T).
+  template <typename T>
+  std::vector<T> array(std::uint32_t tag) const;
+
+ private:
+  std::string path_;
+  TreeKind kind_{};
+  std::uint64_t fingerprint_ = 0;
+  std::uint64_t triangle_count_ = 0;
+  std::map<std::uint32_t, std::vector<std::byte>> sections_;
+};
+
+template <typename T>
+std::vector<T> TreeFileReader::array(std::uint32_t tag) const {
+  static_assert(std::is_trivially_copyable_v<T>, "tree file arrays hold plain data");
+  const std::span<const std::byte> bytes = section(tag);
+  if (bytes.size() % sizeof(T) != 0)
+    throw InputError(path_, "section " + tree_tag_name(tag) + " has " + std::to_string(bytes.size()) +
+                                " bytes, not a multiple of " + std::to_string(sizeof(T)));
+  std::vector<T> v(bytes.size() / sizeof(T));
+  if (!v.empty()) std::memcpy(v.data(), bytes.data(), bytes.size());
+  return v;
+}
+
+}  // namespace bsprt

@@ -1,0 +1,144 @@
+// The `bsprt bench` library on a tiny generated scene with few rays: the
+// outputs are well formed and the error columns mean what they say (the exact
+// reference against itself has no error; the certified modes lose nothing).
+// Behaviour only, never timing.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/bench_report.h"
+#include "apps/bench_runner.h"
+
+using namespace bsprt;
+
+namespace {
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  std::istringstream in(s);
+  while (std::getline(in, cur, sep)) out.push_back(cur);
+  return out;
+}
+
+/// Balanced brackets and braces outside strings, and no trailing commas.
+bool json_looks_well_formed(const std::string& j) {
+  std::string stack;
+  bool in_string = false;
+  char last = 0;
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const char c = j[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    if (c == '"') in_string = true;
+    else if (c == '{' || c == '[') stack.push_back(c);
+    else if (c == '}' || c == ']') {
+      if (stack.empty() || (c == '}') != (stack.back() == '{') || last == ',') return false;
+      stack.pop_back();
+    }
+    if (c != ' ' && c != '\n') last = c;
+  }
+  return stack.empty() && !in_string && j.find("nan") == std::string::npos && j.find("inf") == std::string::npos;
+}
+
+const BenchResult& tiny_run() {
+  static const BenchResult result = [] {
+    std::vector<BenchScene> scenes;
+    scenes.push_back(load_bench_scene("icosphere:2"));
+    BenchOptions o;
+    o.ray_sets = {"primary", "vertex", "inside"};
+    o.modes = {"exact", "brute-certified", "bsp-certified", "bsp", "kd", "embree"};
+    o.count = 1024;
+    o.error_count = 300;
+    o.threads = 2;
+    o.runs = 1;
+    return run_bench(scenes, o);
+  }();
+  return result;
+}
+
+const BenchRow& row(const std::string& set, const std::string& mode) {
+  for (const BenchRow& r : tiny_run().rows)
+    if (r.ray_set == set && r.mode == mode) return r;
+  FAIL("no row " << set << " " << mode);
+  throw;
+}
+
+}  // namespace
+
+TEST_CASE("bench: one row per ray set and mode, with error measured", "[bench]") {
+  const BenchResult& r = tiny_run();
+  REQUIRE(r.rows.size() == 3 * 6);
+  for (const BenchRow& row : r.rows) {
+    CHECK(row.triangles == 320);
+    CHECK(row.error_rays == 300);
+    CHECK(row.rays >= row.error_rays);
+    CHECK(row.error.rays == 300);
+    CHECK(row.mrays_single > 0.0);
+  }
+  CHECK(row("primary", "bsp").packet_width == r.packet_width);
+  CHECK(row("primary", "bsp-certified").packet_width == 1);
+  CHECK(row("primary", "bsp").memory_bytes > 0);
+  CHECK(row("primary", "bsp").triangle_tests > 0.0);
+}
+
+TEST_CASE("bench: exact against itself has zero error; certified modes lose nothing", "[bench]") {
+  for (const std::string set : {"primary", "vertex", "inside"}) {
+    INFO(set);
+    const BenchRow& e = row(set, "exact");
+    CHECK(e.error.agrees());
+    CHECK(e.error.tie == 0);
+    CHECK(e.error.max_t_ulps == 0.0);
+    CHECK(e.median_t_ulps == 0.0);
+    for (const std::string mode : {"bsp-certified", "brute-certified"}) {
+      INFO(mode);
+      CHECK(row(set, mode).error.lost == 0);
+      CHECK(row(set, mode).error.farther == 0);
+    }
+  }
+  // Every ray from inside the closed icosphere hits.
+  CHECK(row("inside", "exact").hits == row("inside", "exact").rays);
+}
+
+TEST_CASE("bench: CSV has the declared columns on every line", "[bench]") {
+  const std::vector<std::string> lines = split(bench_csv(tiny_run()), '\n');
+  const std::vector<std::string> columns = bench_csv_columns();
+  REQUIRE(lines.size() == tiny_run().rows.size() + 1);
+  CHECK(split(lines[0], ',') == columns);
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> cells = split(lines[i], ',');
+    REQUIRE(cells.size() == columns.size());
+    CHECK(cells[0] == "icosphere-2");
+    CHECK(std::all_of(cells.begin(), cells.end(), [](const std::string& c) { return !c.empty(); }));
+  }
+}
+
+TEST_CASE("bench: JSON and Markdown are well formed", "[bench]") {
+  const std::string j = bench_json(tiny_run());
+  CHECK(json_looks_well_formed(j));
+  CHECK(split(j, '\n').size() >= tiny_run().rows.size());
+  std::size_t objects = 0;
+  for (std::size_t p = j.find("\"scene\""); p != std::string::npos; p = j.find("\"scene\"", p + 1)) ++objects;
+  CHECK(objects == tiny_run().rows.size());
+  CHECK_FALSE(json_looks_well_formed("{\"a\": [1, 2,]}"));
+  const std::string md = bench_markdown(tiny_run());
+  std::size_t tables = 0;
+  for (std::size_t p = md.find("| mode |"); p != std::string::npos; p = md.find("| mode |", p + 1)) ++tables;
+  CHECK(tables == 3);
+}
+
+TEST_CASE("bench: bad modes, ray sets and scenes are usage errors", "[bench]") {
+  BenchOptions o;
+  o.modes = {"no-such-mode"};
+  CHECK_THROWS(run_bench({}, o));
+  o.modes = {"kd"};
+  o.ray_sets = {"sideways"};
+  CHECK_THROWS(run_bench({}, o));
+  CHECK_THROWS(load_bench_scene("icosphere:x"));
+}
