@@ -62,7 +62,14 @@ FlatBspTree load_or_build_bsp(const TriangleSoup& soup, const AccelOptions& opti
       throw InputError(options.tree_path, "is a kd-tree file; --accel bsp needs a BSP tree (bsprt build --accel bsp)");
     file.check_scene(soup);
     if (has_flat_bsp_sections(file)) return read_flat_bsp_sections(file, soup);
-    return flatten_bsp(soup, read_bsp_sections(file, soup));
+    const BspTree exact = read_bsp_sections(file, soup);
+    try {
+      return flatten_bsp(soup, exact);
+    } catch (const std::logic_error& e) {  // UsageError and BspTree's own checks: a tree that reads but is
+      // inconsistent (a plane that does not cut its cell, ...) is bad input, not a bug.
+      // Regression test "tree file: a BSP plane that does not cut its cell is an InputError".
+      throw InputError(options.tree_path, std::string("is not a valid BSP tree for this scene: ") + e.what());
+    }
   }
   BspConfig config = options.bsp;
   if (options.threads > 0) config.threads = options.threads;

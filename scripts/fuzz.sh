@@ -9,8 +9,7 @@ set -euo pipefail
 secs=${1:-60}
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DBSPRT_BUILD_FUZZERS=ON -DBUILD_TESTING=OFF -DBSPRT_BUILD_BENCH=OFF >/dev/null
+scripts/configure-instrumented.sh
 fuzzers=$(sed -n 's/^bsprt_add_fuzzer(\([a-z_]*\).*/\1/p' fuzz/CMakeLists.txt)
 cmake --build build-fuzz --target $fuzzers -j "$(nproc)"
 mkdir -p build-fuzz/findings

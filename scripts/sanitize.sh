@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the tests with AddressSanitizer + UndefinedBehaviorSanitizer
-# (-DBSPRT_SANITIZE=ON) in build-asan/ and runs the fast ones: everything but
+# (clang, the instrumented build of scripts/configure-instrumented.sh, shared
+# with the fuzzers) in build-fuzz/ and runs the fast ones: everything but
 # the tests that trace the big shared meshes (bunny, dragon, ...) and the
 # benchmark/CLI round trips, which take minutes under ASan. Any report fails.
 #   scripts/sanitize.sh                 # what CI runs (scripts/test.sh)
@@ -8,10 +9,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBSPRT_SANITIZE=ON \
-  -DBSPRT_BUILD_BENCH=OFF -DBUILD_TESTING=ON >/dev/null
+scripts/configure-instrumented.sh
 targets="test_geometry test_traverse test_exact test_kd test_bsp test_bsp_traverse test_stiff"
-cmake --build build-asan --target $targets -j "$(nproc)"
+cmake --build build-fuzz --target $targets -j "$(nproc)"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # The watertightness test traces 10^6 rays per mode; 10^5 show the same code paths under ASan.
@@ -19,4 +19,4 @@ export BSPRT_WATERTIGHT_RAYS=100000
 # Tests of the targets not built above register as <target>_NOT_BUILT: skipped.
 exclude='_NOT_BUILT|[Bb]unny|[Dd]ragon|[Aa]rmadillo|[Bb]uddha'
 [ "${SANITIZE_ALL:-0}" = 1 ] && exclude='^$'
-ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -E "$exclude" --no-tests=error --timeout 900
+ctest --test-dir build-fuzz --output-on-failure -j "$(nproc)" -E "$exclude" --no-tests=error --timeout 900

@@ -341,7 +341,12 @@ TEST_CASE("bsp: translated by 1e5 and scaled by 1e-4", "[bsp]") {
 
 TEST_CASE("bsp: the checker catches a tampered tree", "[bsp]") {
   const TriangleSoup s = uv_sphere(6, 12);
-  const BspTree t = build_bsp(s, small_config());
+  // Coplanar triangles in both children: then every listing is required, so
+  // dropping any one must be caught (with one-side listing, a coplanar
+  // triangle's copy in a boundary leaf can be redundant).
+  BspConfig config = small_config();
+  config.coplanar_to_both = true;
+  const BspTree t = build_bsp(s, config);
   REQUIRE(check_leaves(s, t) == "");
   std::vector<std::uint32_t> refs = t.triangle_refs();
   std::vector<BspNode> nodes = t.nodes();

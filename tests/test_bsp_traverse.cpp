@@ -3,6 +3,8 @@
 // special rays; packets equal single rays bit for bit (hits and counters);
 // rays from inside closed meshes never escape; the flat sections round-trip.
 #include <catch2/catch.hpp>
+
+#include <algorithm>
 #include <fmt/core.h>
 
 #include <cmath>
@@ -272,10 +274,11 @@ TEST_CASE("BSP work per ray: certified vs zero epsilon vs kd-tree", "[bsp][repor
     for (RaySetKind k : {RaySetKind::Primary, RaySetKind::Random, RaySetKind::Vertex}) {
       const std::vector<Ray> rays = make_rays(k, s.soup, 4096, 3);
       RayCounters a, z, d;
-      std::vector<Hit> h(rays.size());
+      std::vector<Hit> h(rays.size()), hz(rays.size());
       cert.trace_batch(rays, h, 1, &a);
-      zero.trace_batch(rays, h, 1, &z);
-      kd.trace_batch(rays, h, 1, &d);
+      zero.trace_batch(rays, hz, 1, &z);
+      std::vector<Hit> hd(rays.size());
+      kd.trace_batch(rays, hd, 1, &d);
       const auto per = [&](std::uint64_t x) { return double(x) / double(rays.size()); };
       fmt::print("{:16} {:8} certified: bsp {:6.2f} kd {:6.2f} leaves {:5.2f} tris {:5.2f} | zero-eps: "
                  "bsp {:6.2f} kd {:6.2f} tris {:5.2f} | kd-tree: nodes {:6.2f} tris {:5.2f}\n",
@@ -283,7 +286,12 @@ TEST_CASE("BSP work per ray: certified vs zero epsilon vs kd-tree", "[bsp][repor
                  per(a.leaf_visits), per(a.triangle_tests), per(z.bsp_node_visits),
                  per(z.kd_node_visits), per(z.triangle_tests), per(d.kd_node_visits),
                  per(d.triangle_tests));
-      CHECK(z.bsp_node_visits + z.kd_node_visits <= a.bsp_node_visits + a.kd_node_visits);
+      // Visit counts are not monotone in epsilon (an earlier hit can cull later
+      // nodes), but hits are: the certified traversal finds every hit the float
+      // triangle test can report, the zero-epsilon one at most as many.
+      const auto hits = [](const std::vector<Hit>& v) { return std::count_if(v.begin(), v.end(), [](const Hit& x) { return x.hit(); }); };
+      CHECK(hits(h) >= hits(hz));
+      CHECK(hits(h) == hits(hd));  // the kd-tree is conservative too: same hit set
     }
   }
 }

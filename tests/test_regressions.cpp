@@ -2,6 +2,7 @@
 // failure becomes one test here, with the input written out in code.
 #include <catch2/catch.hpp>
 
+#include "geometry/default_scene.h"
 #include "geometry/error.h"
 #include "stiff_util.h"
 
@@ -42,24 +43,17 @@ TEST_CASE("exact reference: a ray in a triangle's plane touching a corner misses
   CHECK(make_tracer("exact", s)->trace(slanted).hit());
 }
 
-#include <cstdio>
-#include "geometry/stiff_rays.h"
-#include "geometry/stiff_scenes.h"
-TEST_CASE("debug", "[.debug]") {
-  const StiffScene sc = make_stiff_scene("stacks");
-  const auto rays = stiff_rays(StiffRayKind::AxisPlane, sc.soup, 300, 1005);
-  auto ex = make_tracer("exact", sc.soup);
-  auto bc = make_tracer("brute-certified", sc.soup);
-  auto br = make_tracer("brute", sc.soup);
-  int shown = 0;
-  for (std::size_t i = 0; i < rays.size() && shown < 4; ++i) {
-    const Ray& r = rays[i];
-    Hit a = ex->trace(r), b = bc->trace(r), c = br->trace(r);
-    if (a.prim == b.prim && (a.t == b.t)) continue;
-    ++shown;
-    std::printf("ray %zu org %.9g %.9g %.9g dir %.9g %.9g %.9g\n exact %u t=%.9g u=%g v=%g\n cert %u t=%.9g\n brute %u t=%.9g\n", i,
-      r.org.x, r.org.y, r.org.z, r.dir.x, r.dir.y, r.dir.z, a.prim, a.t, a.u, a.v, b.prim, b.t, c.prim, c.t);
-    for (std::uint32_t p : {a.prim, b.prim}) if (p != kNoHit) { auto cs = sc.soup.corners(p);
-      std::printf("  tri %u: (%.9g %.9g %.9g) (%.9g %.9g %.9g) (%.9g %.9g %.9g)\n", p, cs[0].x, cs[0].y, cs[0].z, cs[1].x, cs[1].y, cs[1].z, cs[2].x, cs[2].y, cs[2].z); }
-  }
+// Found by fuzz/fuzz_tree_file (fuzz/corpus/tree_file/crash-bsp-plane-not-cutting-cell,
+// stored here with the header patched as the harness patches it): a BSP tree
+// file that reads but whose node 109 has a plane that does not cut its cell
+// made flatten_bsp throw std::logic_error, which escaped make_tracer (the CLI
+// reported an internal error). A bad tree file must be an InputError.
+TEST_CASE("tree file: a BSP plane that does not cut its cell is an InputError", "[regression]") {
+  const std::string dir = std::string(__FILE__).substr(0, std::string(__FILE__).rfind('/'));
+  const TriangleSoup scene = make_icosphere({0.25f, 0.5f, -0.125f}, 1.0f, 1);  // fuzz_tree_file's scene
+  AccelOptions o;
+  o.tree_path = dir + "/regressions/bsp_plane_not_cutting_cell.tree";
+  CHECK_THROWS_AS(make_tracer("bsp", scene, o), InputError);
+  CHECK_THROWS_AS(make_tracer("bsp-certified", scene, o), InputError);
 }
+

@@ -29,10 +29,10 @@ struct ClosedCase {
 std::vector<ClosedCase> closed_cases() {
   const Vec3f far{1e5f, 1e5f, 1e5f};
   std::vector<ClosedCase> c;
-  c.push_back({"icosphere(5120) at 0", make_icosphere({0, 0, 0}, 1.0f, 4), {0, 0, 0}, 0.5f});
-  c.push_back({"icosphere(5120) at 1e5", make_icosphere(far, 1.0f, 4), far, 0.5f});
-  c.push_back({"torus(4608) at 0", make_torus({0, 0, 0}, 1.0f, 0.25f, 96, 24), {1, 0, 0}, 0.125f});
-  c.push_back({"torus(4608) at 1e5", make_torus(far, 1.0f, 0.25f, 96, 24), far + Vec3f{1, 0, 0}, 0.125f});
+  c.push_back({"icosphere(1280) at 0", make_icosphere({0, 0, 0}, 1.0f, 3), {0, 0, 0}, 0.5f});
+  c.push_back({"icosphere(1280) at 1e5", make_icosphere(far, 1.0f, 3), far, 0.5f});
+  c.push_back({"torus(1152) at 0", make_torus({0, 0, 0}, 1.0f, 0.25f, 48, 12), {1, 0, 0}, 0.125f});
+  c.push_back({"torus(1152) at 1e5", make_torus(far, 1.0f, 0.25f, 48, 12), far + Vec3f{1, 0, 0}, 0.125f});
   for (const char* name : {"grid_box", "fan"}) {
     StiffScene s = make_stiff_scene(name);
     c.push_back({name, std::move(s.soup), s.inside, s.inside_radius});

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Configures build-fuzz/: clang with ASan + UBSan + libFuzzer coverage on every
+# library, tests on. One instrumented build serves both scripts/fuzz.sh (the
+# harnesses) and scripts/sanitize.sh (the fast tests under ASan+UBSan), so CI
+# compiles the project twice (gcc Release + this), not three times.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DBSPRT_BUILD_FUZZERS=ON -DBUILD_TESTING=ON -DBSPRT_BUILD_BENCH=OFF >/dev/null
