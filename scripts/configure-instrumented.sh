@@ -5,5 +5,8 @@
 # compiles the project twice (gcc Release + this), not three times.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+# -O1 with line tables only: readable sanitizer stacks at a fraction of the
+# compile time of -O2 -g on the CGAL-heavy files.
+CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Sanitize \
+  -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -gline-tables-only" \
   -DBSPRT_BUILD_FUZZERS=ON -DBUILD_TESTING=ON -DBSPRT_BUILD_BENCH=OFF >/dev/null

@@ -15,6 +15,7 @@
 #include "geometry/error.h"
 #include "robust/degenerate.h"
 #include "traverse/brute_force.h"
+#include "builder/accel_factory.h"
 #include "traverse/embree_tracer.h"
 
 using namespace bsprt;
@@ -81,6 +82,20 @@ TEST_CASE("path tracing: brute force and Embree give the same image up to ties",
   for (std::size_t i = 0; i < a.rgb.size(); i += 3)
     differ += std::abs(a.rgb[i] - b.rgb[i]) > 1e-3f || std::abs(a.rgb[i + 1] - b.rgb[i + 1]) > 1e-3f;
   CHECK(differ <= a.rgb.size() / 3 / 100);  // a tie at a shared edge may change one path
+}
+
+TEST_CASE("path tracing: kd-tree and BSP give the same image up to ties", "[render]") {
+  const TriangleSoup scene = make_default_scene();
+  const auto kd = make_tracer("kd", scene);
+  const auto bsp = make_tracer("bsp", scene);
+  const Image a = render_path(*kd, scene, small_path());
+  const Image b = render_path(*bsp, scene, small_path());
+  // Both use the same watertight test and find the same nearest hit except at
+  // exact ties between two triangles (a shared edge), which may change a path.
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); i += 3)
+    differ += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2];
+  CHECK(differ <= a.rgb.size() / 3 / 100);
 }
 
 TEST_CASE("spawned rays: no self-hit outward, no leak inward, at 1e-4 and 1e5", "[render]") {
