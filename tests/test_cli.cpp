@@ -16,27 +16,8 @@ using namespace bsprt;
 using bsprt::test::scene_path;
 using bsprt::test::temp_path;
 
-namespace {
-
-struct Run {
-  int status;
-  std::string output;  // stdout and stderr
-};
-
-/// Runs `bsprt ARGS` and captures what it prints.
-Run bsprt_cli(const std::string& args) {
-  const std::string cmd = std::string(BSPRT_CLI_PATH) + " " + args + " 2>&1";
-  Run run{0, {}};
-  FILE* pipe = popen(cmd.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), int(buf.size()), pipe)) run.output += buf.data();
-  const int rc = pclose(pipe);
-  run.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-  return run;
-}
-
-}  // namespace
+using Run = bsprt::test::CliRun;
+using bsprt::test::bsprt_cli;
 
 TEST_CASE("render of the default scene writes a PNG of the asked size", "[cli]") {
   const std::string png = temp_path("cli_default.png");

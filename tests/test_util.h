@@ -1,6 +1,11 @@
 #pragma once
 // Helpers shared by the test programs: paths to shared scenes and temp files.
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 namespace bsprt::test {
@@ -14,5 +19,26 @@ inline std::string temp_path(const std::string& name) {
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }
+
+/// Exit status and everything printed (stdout and stderr) of one CLI run.
+struct CliRun {
+  int status;
+  std::string output;
+};
+
+#ifdef BSPRT_CLI_PATH
+/// Runs the real `bsprt ARGS` binary and captures what it prints.
+inline CliRun bsprt_cli(const std::string& args) {
+  const std::string cmd = std::string(BSPRT_CLI_PATH) + " " + args + " 2>&1";
+  CliRun run{0, {}};
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) throw std::runtime_error("cannot run " + cmd);
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), int(buf.size()), pipe)) run.output += buf.data();
+  const int rc = pclose(pipe);
+  run.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  return run;
+}
+#endif
 
 }  // namespace bsprt::test

@@ -248,26 +248,8 @@ TEST_CASE("verify fails on a flat leaf that differs and on a degenerate listed t
   CHECK(r.failure->what.find("flat leaf") != std::string::npos);
 }
 
-namespace {
-
-struct Run {
-  int status;
-  std::string output;
-};
-
-Run bsprt_cli(const std::string& args) {
-  const std::string cmd = std::string(BSPRT_CLI_PATH) + " " + args + " 2>&1";
-  Run run{0, {}};
-  FILE* pipe = popen(cmd.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), int(buf.size()), pipe)) run.output += buf.data();
-  const int rc = pclose(pipe);
-  run.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-  return run;
-}
-
-}  // namespace
+using Run = bsprt::test::CliRun;
+using bsprt::test::bsprt_cli;
 
 TEST_CASE("bsprt verify: exit 0 and CERTIFIED, non-zero with the ids on a tampered tree", "[verify][cli]") {
   const std::string mesh = scene_path("suzanne.obj");
