@@ -113,6 +113,12 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
   CHECK(st.output.find("exact fallbacks") != std::string::npos);
   CHECK(st.output.find("leaves by triangle count") != std::string::npos);
   REQUIRE(bsprt_cli("build " + scene + " -o " + kd + " --accel kd").status == 0);
+  for (const std::string& t : {tree, kd}) {  // both kinds certify
+    const Run v = bsprt_cli("verify " + scene + " " + t);
+    INFO(v.output);
+    CHECK(v.status == 0);
+    CHECK(v.output.find("CERTIFIED") != std::string::npos);
+  }
 
   const std::string rays = temp_path("cli_suzanne_vertex.rays");
   REQUIRE(bsprt_cli("gen-rays " + scene + " --kind vertex -n 3000 --seed 3 -o " + rays).status == 0);
