@@ -191,6 +191,12 @@ Every column of every row (also as CSV and JSON: \`docs/perf/*.csv\`, \`docs/per
 ### All meshes
 $(cat "$PERF/bench.md")
 
+### The other shared meshes (small and stiff), fewer rays
+
+\`$SMALL_CMD\`
+
+$(cat "$PERF/small.md")
+
 ### Bunny, vertex rays
 $(cat "$PERF/vertex-bunny.md")
 
