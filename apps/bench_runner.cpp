@@ -95,35 +95,6 @@ std::vector<Ray> strided_subset(const std::vector<Ray>& rays, std::size_t n) {
   return out;
 }
 
-/// Traces all rays with `width`-wide packets over blocks of 1024 on all
-/// threads of the current arena; returns seconds of the fastest of `runs`.
-double time_trace(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int width,
-                  int runs) {
-  hits.assign(rays.size(), Hit{});
-  double best = 1e30;
-  for (int r = 0; r < std::max(1, runs); ++r) {
-    const auto t0 = Clock::now();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& range) {
-      const std::size_t n = range.end() - range.begin();
-      tracer.trace_batch(std::span<const Ray>(rays.data() + range.begin(), n),
-                         std::span<Hit>(hits.data() + range.begin(), n), width, nullptr);
-    });
-    best = std::min(best, seconds_since(t0));
-  }
-  return best;
-}
-
-/// Work per ray, counted in a separate single-ray pass (counters cost time).
-RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays) {
-  tbb::combinable<RayCounters> local;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i < range.end(); ++i) tracer.trace(rays[i], &local.local());
-  });
-  RayCounters sum;
-  local.combine_each([&](const RayCounters& c) { sum += c; });
-  return sum;
-}
-
 /// A built accelerator with its build time.
 struct BuiltMode {
   std::string mode;
@@ -262,6 +233,36 @@ void check_options(const BenchOptions& o) {
 }
 
 }  // namespace
+
+/// Traces all rays with `width`-wide packets over blocks of 1024 on all
+/// threads of the current arena; returns seconds of the fastest of `runs`.
+double time_trace(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int width,
+                  int runs) {
+  hits.assign(rays.size(), Hit{});
+  double best = 1e30;
+  for (int r = 0; r < std::max(1, runs); ++r) {
+    const auto t0 = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& range) {
+      const std::size_t n = range.end() - range.begin();
+      tracer.trace_batch(std::span<const Ray>(rays.data() + range.begin(), n),
+                         std::span<Hit>(hits.data() + range.begin(), n), width, nullptr);
+    });
+    best = std::min(best, seconds_since(t0));
+  }
+  return best;
+}
+
+/// Work per ray, counted in a separate single-ray pass (counters cost time).
+RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays) {
+  tbb::combinable<RayCounters> local;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) tracer.trace(rays[i], &local.local());
+  });
+  RayCounters sum;
+  local.combine_each([&](const RayCounters& c) { sum += c; });
+  return sum;
+}
+
 
 bool bench_mode_is_certified(const std::string& mode) {
   return mode == "bsp-certified" || mode == "exact" || mode == "brute-certified";

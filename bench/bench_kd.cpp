@@ -16,6 +16,7 @@
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
 
+#include "apps/bench_runner.h"
 #include "builder/kd_build.h"
 #include "geometry/camera.h"
 #include "geometry/load_mesh.h"
@@ -43,33 +44,6 @@ std::vector<Ray> tiled_primary_rays(const TriangleSoup& soup, int width, int hei
       for (int y = ty; y < std::min(ty + 8, height); ++y)
         for (int x = tx; x < std::min(tx + 8, width); ++x) rays.push_back(cam.ray(x, y));
   return rays;
-}
-
-/// Seconds of the fastest of `runs` passes over all rays, all threads.
-double time_trace(const Tracer& tracer, const std::vector<Ray>& rays, int width, int runs) {
-  std::vector<Hit> hits(rays.size());
-  double best = 1e30;
-  for (int r = 0; r < runs; ++r) {
-    const auto t0 = Clock::now();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& range) {
-      const std::size_t n = range.end() - range.begin();
-      tracer.trace_batch(std::span<const Ray>(rays.data() + range.begin(), n),
-                         std::span<Hit>(hits.data() + range.begin(), n), width, nullptr);
-    });
-    best = std::min(best, seconds_since(t0));
-  }
-  return best;
-}
-
-/// kd work per ray (counted in a separate pass).
-RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays) {
-  tbb::combinable<RayCounters> local;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i < range.end(); ++i) tracer.trace(rays[i], &local.local());
-  });
-  RayCounters sum;
-  local.combine_each([&](const RayCounters& c) { sum += c; });
-  return sum;
 }
 
 struct RaySet {
@@ -102,7 +76,8 @@ void bench_scene(const std::string& path, int runs, std::size_t n_random, int wi
     const double n = double(set.rays.size());
     const std::vector<int> modes = width == 1 ? std::vector<int>{1} : std::vector<int>{1, width};
     for (int w : modes) {
-      const double tk = time_trace(kd, set.rays, w, runs), te = time_trace(embree, set.rays, w, runs);
+      std::vector<Hit> hits;
+      const double tk = time_trace(kd, set.rays, hits, w, runs), te = time_trace(embree, set.rays, hits, w, runs);
       fmt::print("| {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.1f} |\n", set.name,
                  w == 1 ? std::string("single") : fmt::format("packet {}", w), n / tk / 1e6,
                  n / te / 1e6, tk / te, double(c.kd_node_visits) / n, double(c.triangle_tests) / n);
