@@ -41,19 +41,11 @@ bool is_slow_mode(const std::string& mode) { return mode == "exact" || mode == "
 
 bool is_bsp_mode(const std::string& mode) { return mode.rfind("bsp", 0) == 0; }
 
-/// Primary rays in 8x8 pixel tiles (row-major inside a tile), so consecutive
-/// rays, and hence packets, are coherent (as bench/bench_kd.cpp).
+/// About n primary rays framing the scene, 4:3, in 8x8 tiles (ray_gen.h).
 std::vector<Ray> tiled_primary_rays(const TriangleSoup& soup, std::size_t n) {
   const int width = std::max(8, int(std::lround(std::sqrt(double(n) * 4.0 / 3.0))));
   const int height = std::max(8, int(std::lround(double(n) / width)));
-  const CameraRays cam(frame_bounds(soup.bounds()), width, height);
-  std::vector<Ray> rays;
-  rays.reserve(std::size_t(width) * std::size_t(height));
-  for (int ty = 0; ty < height; ty += 8)
-    for (int tx = 0; tx < width; tx += 8)
-      for (int y = ty; y < std::min(ty + 8, height); ++y)
-        for (int x = tx; x < std::min(tx + 8, width); ++x) rays.push_back(cam.ray(x, y));
-  return rays;
+  return bsprt::tiled_primary_rays(frame_bounds(soup.bounds()), width, height);
 }
 
 /// Rays from origins uniform in `ball` shrunk to half its radius, directions

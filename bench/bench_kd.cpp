@@ -33,19 +33,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-/// Primary rays in 8x8 pixel tiles (row-major inside a tile), so consecutive
-/// rays, and hence packets, are coherent for both tracers.
-std::vector<Ray> tiled_primary_rays(const TriangleSoup& soup, int width, int height) {
-  const CameraRays cam(frame_bounds(soup.bounds()), width, height);
-  std::vector<Ray> rays;
-  rays.reserve(std::size_t(width) * std::size_t(height));
-  for (int ty = 0; ty < height; ty += 8)
-    for (int tx = 0; tx < width; tx += 8)
-      for (int y = ty; y < std::min(ty + 8, height); ++y)
-        for (int x = tx; x < std::min(tx + 8, width); ++x) rays.push_back(cam.ray(x, y));
-  return rays;
-}
-
 struct RaySet {
   std::string name;
   std::vector<Ray> rays;
@@ -67,7 +54,7 @@ void bench_scene(const std::string& path, int runs, std::size_t n_random, int wi
              kd_build, embree_build, kd_build / embree_build, report.nodes, report.leaves,
              report.empty_leaves, report.avg_leaf_size, report.max_depth, report.depth_limit,
              double(kd.memory_bytes()) / 1e6);
-  const std::vector<RaySet> sets = {{"primary", tiled_primary_rays(soup, 1024, 768)},
+  const std::vector<RaySet> sets = {{"primary", tiled_primary_rays(frame_bounds(soup.bounds()), 1024, 768)},
                                     {"random", random_rays(soup, n_random, 1)}};
   fmt::print("| rays | mode | kd Mrays/s | Embree Mrays/s | kd time / Embree time | kd node visits/ray | kd tri tests/ray |\n");
   fmt::print("|---|---|---:|---:|---:|---:|---:|\n");

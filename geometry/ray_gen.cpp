@@ -68,6 +68,17 @@ std::vector<Ray> primary_rays(const Camera& cam, int width, int height) {
   return rays;
 }
 
+std::vector<Ray> tiled_primary_rays(const Camera& cam, int width, int height, int tile) {
+  const CameraRays gen(cam, width, height);
+  std::vector<Ray> rays;
+  rays.reserve(std::size_t(width) * std::size_t(height));
+  for (int ty = 0; ty < height; ty += tile)
+    for (int tx = 0; tx < width; tx += tile)
+      for (int y = ty; y < std::min(ty + tile, height); ++y)
+        for (int x = tx; x < std::min(tx + tile, width); ++x) rays.push_back(gen.ray(x, y));
+  return rays;
+}
+
 std::vector<Ray> random_rays(const TriangleSoup& soup, std::size_t n, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   const OriginSampler origin(soup);

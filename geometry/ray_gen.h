@@ -25,6 +25,10 @@ RaySetKind parse_ray_set(const std::string& name);
 /// One primary ray per pixel centre, row-major from the top-left pixel.
 std::vector<Ray> primary_rays(const Camera& cam, int width, int height);
 
+/// The same rays in `tile` x `tile` pixel tiles (row-major inside a tile, tiles
+/// row-major), so consecutive rays, and hence packets, are coherent.
+std::vector<Ray> tiled_primary_rays(const Camera& cam, int width, int height, int tile = 8);
+
 /// `n` rays with origins uniform in the scene box enlarged by 10% per side and
 /// directions uniform on the sphere.
 std::vector<Ray> random_rays(const TriangleSoup& soup, std::size_t n, std::uint64_t seed);

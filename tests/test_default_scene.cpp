@@ -83,5 +83,13 @@ TEST_CASE("generated ray sets aim where they say", "[ray_gen]") {
     CHECK(best < 1e-5f);
   }
   CHECK(primary_rays(default_scene_camera(), 32, 24).size() == 32u * 24u);
+  // Tiled primary rays are the same rays, reordered tile by tile (20 x 13: partial tiles).
+  const auto flat = primary_rays(default_scene_camera(), 20, 13);
+  const auto tiled = tiled_primary_rays(default_scene_camera(), 20, 13, 8);
+  REQUIRE(tiled.size() == flat.size());
+  CHECK(tiled[1].dir == flat[1].dir);          // (1, 0): first tile's first row
+  CHECK(tiled[8].dir == flat[20].dir);         // (0, 1): first tile's second row
+  CHECK(tiled[64].dir == flat[8].dir);         // (8, 0): second tile starts
+  CHECK(tiled.back().dir == flat.back().dir);  // (19, 12): last pixel last
   CHECK_THROWS_AS(parse_ray_set("sideways"), UsageError);
 }
