@@ -25,6 +25,7 @@ struct BuildArgs {
   int threads = 0;
   bool allow_nonfinite = false;
   bool paper = false;  // the paper's full BSP: face/edge candidates at every node size
+  BspConfig costs;     // bsp: SAH constants (--cost-*), defaults of BspConfig
 };
 
 void print_kd_stats(const KdTreeStats& s) {
@@ -94,7 +95,7 @@ void print_bsp_figures(const BspFigures& f) {
 }
 
 void build_bsp_file(const BuildArgs& a, const TriangleSoup& soup) {
-  BspConfig config;
+  BspConfig config = a.costs;
   config.membership = parse_membership(a.membership);
   config.threads = a.threads;
   if (a.paper) config.bsp_max_triangles = SIZE_MAX;
@@ -164,6 +165,18 @@ void register_build(CLI::App& app) {
   cmd->add_option("--membership", args->membership, "bsp: area (default) or closed, see docs/bsp-build.md")
       ->capture_default_str();
   cmd->add_flag("--paper", args->paper, "bsp: evaluate face/edge planes at every node (the paper's full, slow build)");
+  cmd->add_option("--cost-isect", args->costs.c_isect, "bsp SAH: cost of one triangle test")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--cost-kd", args->costs.c_kd, "bsp SAH: cost of a kd node")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--cost-bsp-slope", args->costs.c_bsp_slope,
+                  "bsp SAH: C_BSP = slope*C_isect*(N-2) + C_kd where a kd split cuts the node")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--cost-bsp-fixed", args->costs.c_bsp_fixed, "bsp SAH: C_BSP where no kd split cuts the node")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--min-gain", args->costs.min_gain,
+                  "bsp: least expected triangle tests per ray a split must save (docs/bsp-build.md)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
   cmd->callback([args] { run_build(*args); });

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <fmt/core.h>
 
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <chrono>
@@ -122,6 +123,85 @@ TEST_CASE("flat BSP node layout and a hand-built tree", "[bsp]") {
   FlatBspTree bad = t;
   bad.nodes[0].bits = (2u << 3) | 3u;  // second child == first child
   CHECK_THROWS(bad.validate());
+}
+
+namespace {
+
+std::uint64_t flat_refs(const FlatBspTree& f, std::uint32_t i) {
+  const FlatBspNode& n = f.nodes[i];
+  return n.is_leaf() ? n.prim_count() : flat_refs(f, i + n.slots()) + flat_refs(f, n.second_child());
+}
+
+/// Walks flat node fi (listing triangles) and compact node ci together: same
+/// kinds, every float bit for bit, same leaf ranges, and a child is absent
+/// from the compact tree exactly when its flat subtree lists no triangle.
+void check_compact_node(const FlatBspTree& f, const CompactBspTree& c, std::uint32_t fi, std::uint32_t ci,
+                        std::size_t& reached_slots, std::size_t& refs) {
+  const FlatBspNode& fn = f.nodes[fi];
+  REQUIRE(ci < c.slots.size());
+  const CompactBspSlot& cn = c.slots[ci];
+  REQUIRE(cn.kind_bits() == (fn.bits & 7u));
+  reached_slots += cn.slots();
+  if (fn.is_leaf()) {
+    CHECK(cn.prim_offset() == fn.prim_offset());
+    CHECK(cn.prim_count() == fn.prim_count());
+    CHECK(cn.prim_count() > 0);
+    refs += cn.prim_count();
+    return;
+  }
+  if (fn.is_plane()) {
+    for (int k = 0; k < 3; ++k)
+      CHECK(std::bit_cast<std::uint32_t>(c.normal(ci, k)) == std::bit_cast<std::uint32_t>(fn.normal(k)));
+    CHECK(std::bit_cast<std::uint32_t>(c.plane_d(ci)) == f.nodes[fi + 1].bits);
+    CHECK(std::bit_cast<std::uint32_t>(c.plane_eps(ci)) == f.nodes[fi + 1].w[0]);
+  } else {
+    CHECK(std::bit_cast<std::uint32_t>(cn.split()) == fn.w[0]);
+  }
+  const std::uint32_t ff = fi + fn.slots(), fs = fn.second_child();
+  const bool fe = flat_refs(f, ff) == 0, se = flat_refs(f, fs) == 0;
+  CHECK(cn.first_empty() == fe);
+  CHECK(cn.second_empty() == se);
+  if (!fe) check_compact_node(f, c, ff, ci + cn.slots(), reached_slots, refs);
+  if (!se) check_compact_node(f, c, fs, cn.second_child(), reached_slots, refs);
+}
+
+}  // namespace
+
+TEST_CASE("compact traversal layout keeps every float and drops only empty subtrees", "[bsp]") {
+  STATIC_REQUIRE(sizeof(CompactBspSlot) == 8);
+  for (TriangleSoup soup : {load_mesh(scene_path("suzanne.obj")), make_default_scene(), make_coplanar_stack()}) {
+    const BspScene s = build_bsp_scene(std::move(soup));
+    const CompactBspTree c = compact_bsp(s.flat);
+    const FlatBspStats fs = flat_bsp_stats(s.flat);
+    REQUIRE(fs.empty_leaves > 0);  // the case this layout exists for
+    std::size_t reached = 0, refs = 0;
+    check_compact_node(s.flat, c, 0, 0, reached, refs);
+    CHECK(reached == c.slots.size());  // no slot left unreached
+    CHECK(refs == s.flat.prims.size());
+    CHECK(c.slots.size() * sizeof(CompactBspSlot) < s.flat.nodes.size() * sizeof(FlatBspNode));  // fewer bytes
+  }
+  // A subtree of empty leaves collapses into its parent's flag; a tree without
+  // triangles is one empty root leaf.
+  FlatBspTree t;
+  t.bounds = {{0, 0, 0}, {1, 1, 1}};
+  t.triangle_count = 1;
+  t.nodes = {FlatBspNode::make_kd(0, 0.5f, 4), FlatBspNode::make_kd(1, 0.5f, 3), FlatBspNode::make_leaf(0, 0),
+             FlatBspNode::make_leaf(0, 0), FlatBspNode::make_leaf(0, 1)};
+  t.prims = {0};
+  REQUIRE_NOTHROW(t.validate());
+  const CompactBspTree c = compact_bsp(t);
+  REQUIRE(c.slots.size() == 2);
+  CHECK(c.slots[0].first_empty());
+  CHECK(!c.slots[0].second_empty());
+  CHECK(c.slots[0].second_child() == 1);
+  CHECK(c.slots[1].is_leaf());
+  CHECK(c.slots[1].prim_count() == 1);
+  t.nodes[4] = FlatBspNode::make_leaf(0, 0);
+  t.prims.clear();
+  const CompactBspTree e = compact_bsp(t);
+  REQUIRE(e.slots.size() == 1);
+  CHECK(e.slots[0].is_leaf());
+  CHECK(e.slots[0].prim_count() == 0);
 }
 
 TEST_CASE("BSP hits equal brute force on shared meshes", "[bsp]") {

@@ -10,11 +10,13 @@
 /// Everything inline lives in the ISA inline namespace of simd.h (ODR: the
 /// AVX-512 copy of an inline function must never serve the baseline caller).
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 
 #include "geometry/ray.h"
+#include "traverse/bsp_compact.h"
 #include "traverse/bsp_node.h"
 #include "traverse/leaf_intersector.h"
 #include "traverse/counters.h"
@@ -48,7 +50,7 @@ inline constexpr float kSafeMinDir = 0x1p-64f;
 /// Raw view of a BspTracer for kernels that must not instantiate std::
 /// templates compiled for their ISA.
 struct BspView {
-  const FlatBspNode* nodes;
+  const CompactBspSlot* nodes;   ///< the traversal layout (bsp_compact.h)
   const std::uint32_t* prims;
   const BspTriangle* triangles;  ///< parallel to prims
   Box3f bounds;                  ///< root cell
@@ -113,21 +115,23 @@ inline void kd_cut(float split, F o_k, F inv_k, F& near_hi, F& far_lo) {
   far_lo = widen_dn(t);
 }
 
-/// Plane node at n[0] (head) and n[1] (tail) (docs/certified-epsilons.md
+/// Plane node in slots n[0..2] (bsp_compact.h) (docs/certified-epsilons.md
 /// §2-3): a = fl(n·o + d), b = fl(n·dir)
 /// (flushed to +0 when subnormal), E = eps + err_o + err_d·max(|t0|, |t1|)
 /// bounds |exact plane(o + t·dir) − (a + b·t)| over the cell for every t in
 /// [t0, t1]. The first child (value <= 0) needs a + b·t <= E, the second
 /// a + b·t >= −E. Returns the slope b: near is the first child iff b >= 0.
 template <typename F>
-inline F plane_cut(const FlatBspNode* n, const F (&o)[3], const F (&dir)[3], F err_o, F err_d,
+inline F plane_cut(const CompactBspSlot* n, const F (&o)[3], const F (&dir)[3], F err_o, F err_d,
                    F t0, F t1, F& near_hi, F& far_lo) {
-  const float n0 = n[0].normal(0), n1 = n[0].normal(1), n2 = n[0].normal(2);
-  const F a = ((n0 * o[0] + n1 * o[1]) + n2 * o[2]) + n[1].tail_d();
+  const float n0 = std::bit_cast<float>(n[0].word), n1 = std::bit_cast<float>(n[1].head),
+              n2 = std::bit_cast<float>(n[1].word), d = std::bit_cast<float>(n[2].head),
+              eps = std::bit_cast<float>(n[2].word);
+  const F a = ((n0 * o[0] + n1 * o[1]) + n2 * o[2]) + d;
   F b = (n0 * dir[0] + n1 * dir[1]) + n2 * dir[2];
   b = gabs(b) < kTiny ? F{} : b;
   const F at0 = gabs(t0), at1 = gabs(t1);
-  const F e = (n[1].tail_eps() + err_o) + err_d * (at0 > at1 ? at0 : at1);
+  const F e = (eps + err_o) + err_d * (at0 > at1 ? at0 : at1);
   const F inv = 1.0f / b;
   const F q_first = (e - a) * inv, q_second = (-e - a) * inv;
   const auto flip = b < 0.0f;

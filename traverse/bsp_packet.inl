@@ -73,7 +73,7 @@ inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count
 }
 
 template <int W, bool kCount>
-inline void packet_leaf(const BspView& v, const FlatBspNode& n, const WatertightPacket<W>& pre,
+inline void packet_leaf(const BspView& v, const CompactBspSlot& n, const WatertightPacket<W>& pre,
                         PacketHit<W>& hit, vmask<W> active, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if constexpr (kCount) {
@@ -90,7 +90,7 @@ inline void packet_leaf(const BspView& v, const FlatBspNode& n, const Watertight
 /// The node step for all lanes: conservative near_hi / far_lo, and the lanes
 /// whose near child is the second one.
 template <int W>
-inline vmask<W> cut_node(const FlatBspNode& n, const BspPacketRay<W>& r, vfloat<W> tmin,
+inline vmask<W> cut_node(const CompactBspSlot& n, const BspPacketRay<W>& r, vfloat<W> tmin,
                          vfloat<W> tmax, vfloat<W>& near_hi, vfloat<W>& far_lo) {
   if (n.is_plane()) {
     const vfloat<W> b = detail::plane_cut<vfloat<W>>(&n, r.o, r.dir, r.err_o, r.err_d, tmin, tmax,
@@ -112,7 +112,8 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPa
   int sp = 0;
   std::uint32_t node = 0;
   for (;;) {
-    const FlatBspNode* n = &v.nodes[node];
+    const CompactBspSlot* n = &v.nodes[node];
+    bool leaf = true;
     while (!n->is_leaf()) {
       vfloat<W> near_hi, far_lo;
       const vmask<W> flip = cut_node<W>(*n, r, tmin, tmax, near_hi, far_lo);
@@ -130,7 +131,11 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPa
       }
       const std::uint32_t first = node + n->slots(), second = n->second_child();
       const std::uint32_t near = fl ? second : first, far = fl ? first : second;
-      const vmask<W> go_near = active & ~(near_hi < tmin), go_far = active & ~(far_lo > tmax);
+      // A child that lists no triangle is not stored (bsp_compact.h): no lane goes there.
+      const bool near_empty = fl ? n->second_empty() : n->first_empty();
+      const bool far_empty = fl ? n->first_empty() : n->second_empty();
+      const vmask<W> go_near = near_empty ? mask_false<W>() : active & ~(near_hi < tmin);
+      const vmask<W> go_far = far_empty ? mask_false<W>() : active & ~(far_lo > tmax);
       const vfloat<W> near_max = near_hi < tmax ? near_hi : tmax;
       const vfloat<W> far_min = far_lo > tmin ? far_lo : tmin;
       if (any<W>(go_far)) {
@@ -143,11 +148,12 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPa
       } else if (any<W>(go_near)) {
         node = near, tmax = near_max, active = go_near;
       } else {
+        leaf = false;
         break;
       }
       n = &v.nodes[node];
     }
-    if (n->is_leaf()) packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
+    if (leaf) packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
     for (;;) {
       if (sp == 0) return;
       const BspPacketEntry<W>& e = stack[--sp];

@@ -26,8 +26,8 @@ struct StackEntry {
 /// Tests the triangles of a leaf (ties keep the earlier triangle). With an
 /// exact leaf test, `nearest` keeps the exact order and hit mirrors it.
 template <bool kCount>
-inline void intersect_leaf(const BspView& v, const FlatBspNode& n, const Ray& ray, const WatertightRay& wr, Hit& hit,
-                           NearestHit& nearest, RayCounters* c) {
+inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray& ray, const WatertightRay& wr,
+                           Hit& hit, NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if constexpr (kCount) ++c->leaf_visits;
   if (v.exact_leaf) {
@@ -46,24 +46,25 @@ inline void intersect_leaf(const BspView& v, const FlatBspNode& n, const Ray& ra
 /// One inner node: the near child's upper end and the far child's lower end
 /// of the ray interval, and whether near is the second child.
 template <bool kCount>
-inline bool cut_node(const FlatBspNode& n, const BspRayConst& rc, float tmin, float tmax,
+inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float tmin, float tmax,
                      float& near_hi, float& far_lo, RayCounters* c) {
-  if (n.is_plane()) {
+  if (n->is_plane()) {
     if constexpr (kCount) ++c->bsp_node_visits;
-    const float b = detail::plane_cut<float>(&n, rc.o, rc.dir, rc.err_o, rc.err_d, tmin, tmax,
+    const float b = detail::plane_cut<float>(n, rc.o, rc.dir, rc.err_o, rc.err_d, tmin, tmax,
                                              near_hi, far_lo);
     return b < 0.0f;
   }
   if constexpr (kCount) ++c->kd_node_visits;
-  const int k = n.axis();
-  detail::kd_cut<float>(n.split(), rc.o[k], rc.inv[k], near_hi, far_lo);
+  const int k = n->axis();
+  detail::kd_cut<float>(n->split(), rc.o[k], rc.inv[k], near_hi, far_lo);
   return rc.neg[k];
 }
 
 /// Front-to-back traversal (pbrt's kd-tree loop with the paper's BSP node
-/// step, made conservative). A child is culled only when its conservative
-/// interval is empty; NaN crossings cull nothing; a popped cell is skipped
-/// when it starts past the nearest hit. bsp_packet.inl repeats these steps.
+/// step, made conservative). A child is culled when its conservative interval
+/// is empty (NaN crossings cull nothing) or when it lists no triangle (not
+/// stored, bsp_compact.h); a popped cell is skipped when it starts past the
+/// nearest hit. bsp_packet.inl repeats these steps.
 template <bool kCount>
 Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
   Hit hit;
@@ -77,13 +78,17 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
   int sp = 0;
   std::uint32_t node = 0;
   for (;;) {
-    const FlatBspNode* n = &v.nodes[node];
+    const CompactBspSlot* n = &v.nodes[node];
+    bool leaf = true;
     while (!n->is_leaf()) {
       float near_hi, far_lo;
-      const bool flip = cut_node<kCount>(*n, rc, tmin, tmax, near_hi, far_lo, c);
+      const bool flip = cut_node<kCount>(n, rc, tmin, tmax, near_hi, far_lo, c);
       const std::uint32_t first = node + n->slots(), second = n->second_child();
       const std::uint32_t near = flip ? second : first, far = flip ? first : second;
-      const bool go_near = !(near_hi < tmin), go_far = !(far_lo > tmax);  // NaN: both
+      // Empty bits: first child at bit 3, second at bit 4 (bsp_compact.h).
+      const std::uint32_t h = n->head;
+      const bool near_empty = (h >> (3 + flip)) & 1u, far_empty = (h >> (4 - flip)) & 1u;
+      const bool go_near = !(near_hi < tmin) && !near_empty, go_far = !(far_lo > tmax) && !far_empty;  // NaN: both
       if (go_far) {
         const float far_min = far_lo > tmin ? far_lo : tmin;
         if (go_near) {
@@ -98,11 +103,12 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
         node = near;
         tmax = near_hi < tmax ? near_hi : tmax;
       } else {
+        leaf = false;
         break;
       }
       n = &v.nodes[node];
     }
-    if (n->is_leaf()) intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
+    if (leaf) intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
     for (;;) {
       if (sp == 0) return hit;
       const StackEntry& e = stack[--sp];
@@ -135,6 +141,8 @@ BspTracer::BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode
   if (mode_ == BspEpsilon::Zero)
     for (std::size_t i = 0; i + 1 < tree_.nodes.size(); ++i)
       if (tree_.nodes[i].is_plane()) tree_.nodes[++i].set_tail_eps(0.0f);
+  compact_ = compact_bsp(tree_);
+  tree_.nodes = {};  // traversal reads compact_; the leaf lists stay in tree_.prims
   triangles_.resize(tree_.prims.size());
   for (std::size_t i = 0; i < tree_.prims.size(); ++i) {
     const auto c = soup.corners(tree_.prims[i]);
@@ -143,15 +151,15 @@ BspTracer::BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode
 }
 
 namespace {
-BspView make_view(const FlatBspTree& t, const std::vector<BspTriangle>& tris, BspEpsilon mode,
-                  const LeafIntersector* exact_leaf) {
-  return BspView{t.nodes.data(), t.prims.data(), tris.data(), t.bounds, mode == BspEpsilon::Certified,
+BspView make_view(const FlatBspTree& t, const CompactBspTree& c, const std::vector<BspTriangle>& tris,
+                  BspEpsilon mode, const LeafIntersector* exact_leaf) {
+  return BspView{c.slots.data(), t.prims.data(), tris.data(), t.bounds, mode == BspEpsilon::Certified,
                  exact_leaf};
 }
 }  // namespace
 
 Hit BspTracer::trace(const Ray& ray, RayCounters* counters) const {
-  const BspView v = make_view(tree_, triangles_, mode_, exact_leaf_);
+  const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
   if (tree_.bounds.empty()) {
     if (counters) ++counters->rays;
     return Hit{};
@@ -172,7 +180,7 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
     for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
     return;
   }
-  const BspView v = make_view(tree_, triangles_, mode_, exact_leaf_);
+  const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
   switch (need) {
     case Isa::Sse42:
       detail::bsp_trace_packets_sse42(v, rays.data(), rays.size(), hits.data(), counters);
@@ -188,7 +196,8 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
 }
 
 std::size_t BspTracer::memory_bytes() const {
-  return tree_.memory_bytes() + triangles_.size() * sizeof(BspTriangle);
+  return compact_.slots.size() * sizeof(CompactBspSlot) + tree_.prims.size() * sizeof(std::uint32_t) +
+         triangles_.size() * sizeof(BspTriangle);
 }
 
 }  // namespace bsprt

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "geometry/triangle_soup.h"
+#include "traverse/bsp_compact.h"
 #include "traverse/bsp_node.h"
 #include "traverse/leaf_intersector.h"
 #include "traverse/tracer.h"
@@ -61,11 +62,13 @@ class BspTracer final : public Tracer {
   /// Nodes, leaf lists and the copied triangles.
   std::size_t memory_bytes() const override;
 
-  const FlatBspTree& tree() const { return tree_; }
   BspEpsilon mode() const { return mode_; }
+  /// The traversal layout made from the tree (bsp_compact.h).
+  const CompactBspTree& compact() const { return compact_; }
 
  private:
-  FlatBspTree tree_;
+  FlatBspTree tree_;  ///< bounds, leaf lists; nodes dropped after compacting
+  CompactBspTree compact_;
   BspEpsilon mode_;
   const LeafIntersector* exact_leaf_ = nullptr;
   std::vector<BspTriangle> triangles_;  ///< triangles_[i] = corners of tree_.prims[i]
