@@ -6,7 +6,7 @@
 /// first child adjacent; axis-aligned splits stay kd nodes (the paper's "kd-tree
 /// traversal for axis-aligned splits": no dot product); one array of leaf
 /// triangle lists. Made once from the exact tree by builder/bsp_flatten.h; traced by
-/// traverse/bsp_traverse.h. No CGAL here.
+/// traverse/bsp_traverse.h (through its compact copy, bsp_compact.h). No CGAL here.
 
 #include <bit>
 #include <cstddef>
