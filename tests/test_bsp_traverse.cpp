@@ -237,7 +237,21 @@ TEST_CASE("BSP packets equal single rays exactly", "[bsp]") {
   const BspScene q = build_bsp_scene(make_default_scene());
   for (const BspScene* sc : {&s, &q}) {
     const BspTracer tracer(sc->flat, sc->soup);
-    const std::vector<Ray> rays = all_ray_sets(sc->soup, 1000, 11);
+    std::vector<Ray> rays = all_ray_sets(sc->soup, 1000, 11);
+    // The same rays again, every third from a point inside the scene's box with
+    // tnear < 0 (its interval starts behind the origin, negative crossings): packets
+    // that mix such lanes with ordinary ones.
+    const Box3f box = sc->soup.bounds();
+    const Vec3f mid = (box.lo + box.hi) * 0.5f;
+    const std::size_t n = rays.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      Ray r = rays[i];
+      if (i % 3 == 0) {
+        r.org = mid + (r.org - mid) * 0.01f;
+        r.tnear = -1e6f;
+      }
+      rays.push_back(r);
+    }
     std::vector<Hit> single(rays.size());
     RayCounters cs;
     tracer.trace_batch(rays, single, 1, &cs);
