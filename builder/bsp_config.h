@@ -33,6 +33,9 @@ struct BspConfig {
   double c_kd = 10.0;         ///< traversal cost of a kd (axis-aligned) node
   double c_bsp_slope = 0.1;   ///< C_BSP = c_bsp_slope·c_isect·(N−2) + c_kd when a kd split cuts the node
   double c_bsp_fixed = 20.0;  ///< C_BSP when no kd candidate cuts the node
+  /// Split cost factor when one child lists no triangle (Wald–Havran's empty-space
+  /// bonus; the kd-tree builder uses 0.8). 1 = none, the reference constants.
+  double empty_bonus = 1.0;
   int max_depth = 64;         ///< nodes at this depth become leaves
   /// A split must save at least this many expected triangle tests per ray over
   /// the whole tree: (leaf cost − split cost)/C_isect · area(cell)/area(root).

@@ -22,6 +22,7 @@
 #include <string>
 
 #include "builder/bsp_build.h"
+#include "builder/bsp_candidates.h"
 #include "builder/bsp_file.h"
 #include "geometry/error.h"
 #include "geometry/load_mesh.h"
@@ -297,12 +298,33 @@ TEST_CASE("bsp: random triangles, every membership rule and candidate set", "[bs
   SECTION("area rule") { c.membership = BspMembership::Area; build_checked(s, c); }
   SECTION("coplanar to one side") { c.coplanar_to_both = false; build_checked(s, c); }
   SECTION("kd only") { c.face_candidates = c.edge_candidates = false; build_checked(s, c); }
+  SECTION("empty-space bonus") { c.empty_bonus = 0.8; build_checked(s, c); }
   SECTION("face only") { c.kd_candidates = c.edge_candidates = false; build_checked(s, c); }
   SECTION("edge only, full BSP everywhere") {
     c.kd_candidates = c.face_candidates = false;
     c.bsp_max_triangles = SIZE_MAX;
     build_checked(s, c);
   }
+}
+
+TEST_CASE("bsp: SAH cost with the empty-space bonus", "[bsp]") {
+  BspConfig c;
+  SplitCount one_side;
+  one_side.left = 4;  // right child empty
+  SplitCount both_sides;
+  both_sides.left = 2, both_sides.right = 2;
+  const double plain = sah_cost(c, 10.0, one_side, 0.5, 0.5, 1.0);
+  CHECK(plain == Approx(10.0 + 75.0 * 0.5 * 4));
+  c.empty_bonus = 0.8;
+  CHECK(sah_cost(c, 10.0, one_side, 0.5, 0.5, 1.0) == Approx(0.8 * plain));
+  CHECK(sah_cost(c, 10.0, both_sides, 0.5, 0.5, 1.0) == Approx(10.0 + 75.0 * (0.5 * 2 + 0.5 * 2)));
+  // A coplanar triangle placed on the empty side earns no bonus; on the other side it does.
+  SplitCount coplanar = one_side;
+  coplanar.coplanar = 1;
+  bool left = false;
+  const double cost = sah_cost(c, 10.0, coplanar, 0.5, 0.5, 1.0, &left);
+  CHECK(left);
+  CHECK(cost == Approx(0.8 * (10.0 + 75.0 * 0.5 * 5)));
 }
 
 TEST_CASE("bsp: tessellated sphere and cube", "[bsp]") {
