@@ -175,8 +175,8 @@ void register_build(CLI::App& app) {
   cmd->add_option("--cost-bsp-fixed", args->costs.c_bsp_fixed, "bsp SAH: C_BSP where no kd split cuts the node")
       ->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--empty-bonus", args->costs.empty_bonus,
-                  "bsp SAH: cost factor of a split with an empty child (kd-tree: 0.8; 1 = none)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+                  "bsp SAH: cost factor in (0, 1] of a split with an empty child (kd-tree: 0.8; 1 = none)")
+      ->capture_default_str()->check(CLI::PositiveNumber)->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--min-gain", args->costs.min_gain,
                   "bsp: least expected triangle tests per ray a split must save (docs/bsp-build.md)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);

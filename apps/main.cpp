@@ -23,7 +23,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // CLI11 prints the message (or the help); its own codes (105, 106, ...)
+    // become the documented usage code 2.
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const bsprt::cli::CompareFailed&) {
     return 1;
   } catch (const bsprt::InputError& e) {

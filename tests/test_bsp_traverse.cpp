@@ -151,9 +151,9 @@ void check_compact_node(const FlatBspTree& f, const CompactBspTree& c, std::uint
   }
   if (fn.is_plane()) {
     for (int k = 0; k < 3; ++k)
-      CHECK(std::bit_cast<std::uint32_t>(c.normal(ci, k)) == std::bit_cast<std::uint32_t>(fn.normal(k)));
-    CHECK(std::bit_cast<std::uint32_t>(c.plane_d(ci)) == f.nodes[fi + 1].bits);
-    CHECK(std::bit_cast<std::uint32_t>(c.plane_eps(ci)) == f.nodes[fi + 1].w[0]);
+      CHECK(std::bit_cast<std::uint32_t>(cn.plane_normal(k)) == std::bit_cast<std::uint32_t>(fn.normal(k)));
+    CHECK(std::bit_cast<std::uint32_t>(cn.plane_d()) == f.nodes[fi + 1].bits);
+    CHECK(std::bit_cast<std::uint32_t>(cn.plane_eps()) == f.nodes[fi + 1].w[0]);
   } else {
     CHECK(std::bit_cast<std::uint32_t>(cn.split()) == fn.w[0]);
   }

@@ -150,3 +150,29 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
   CHECK(kind.status == 1);
   CHECK(kind.output.find("kd-tree") != std::string::npos);
 }
+
+TEST_CASE("build --accel bsp with other SAH constants is certified and equals brute force and rejects bad values", "[cli]") {
+  const std::string scene = scene_path("suzanne.obj");
+  const std::string tree = temp_path("cli_suzanne_costs.bsp");
+  const Run b = bsprt_cli("build " + scene + " -o " + tree +
+                          " --accel bsp --threads 2 --cost-isect 20 --cost-kd 5 --empty-bonus 0.8 --min-gain 1e-4");
+  INFO(b.output);
+  REQUIRE(b.status == 0);
+  const Run v = bsprt_cli("verify " + scene + " " + tree);
+  INFO(v.output);
+  CHECK(v.status == 0);
+  CHECK(v.output.find("CERTIFIED") != std::string::npos);
+  const std::string rays = temp_path("cli_suzanne_costs.rays");
+  REQUIRE(bsprt_cli("gen-rays " + scene + " --kind edge -n 2000 --seed 5 -o " + rays).status == 0);
+  const std::string bh = temp_path("cli_costs_brute.hits"), th = temp_path("cli_costs_bsp.hits");
+  REQUIRE(bsprt_cli("trace " + scene + " " + rays + " -o " + bh + " --accel brute").status == 0);
+  REQUIRE(bsprt_cli("trace " + scene + " " + rays + " -o " + th + " --accel bsp --tree " + tree).status == 0);
+  CHECK(compare_hits(read_hits(bh), read_hits(th)).agrees());
+
+  for (const std::string bad : {"--empty-bonus 0", "--empty-bonus 1.5", "--cost-isect -1", "--cost-kd 0"}) {
+    const Run r = bsprt_cli("build " + scene + " -o " + temp_path("x.bsp") + " --accel bsp " + bad);
+    INFO(bad << ": " << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(bad.substr(0, bad.find(' '))) != std::string::npos);
+  }
+}

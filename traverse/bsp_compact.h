@@ -58,19 +58,18 @@ struct alignas(8) CompactBspSlot {
   std::uint32_t second_child() const { return head >> kShift; }
   std::uint32_t prim_count() const { return head >> kShift; }
   std::uint32_t prim_offset() const { return word; }
+  /// Plane node (this slot and the two after it): normal component k, offset d, epsilon.
+  float plane_normal(int k) const {
+    return std::bit_cast<float>(k == 0 ? word : k == 1 ? this[1].head : this[1].word);
+  }
+  float plane_d() const { return std::bit_cast<float>(this[2].head); }
+  float plane_eps() const { return std::bit_cast<float>(this[2].word); }
 };
 static_assert(sizeof(CompactBspSlot) == 8, "CompactBspSlot must be 8 bytes");
 
 /// The traversal layout of one flat BSP tree. Node 0 is the root.
 struct CompactBspTree {
   std::vector<CompactBspSlot> slots;
-
-  /// Plane node at slot i: normal component k, offset d, epsilon.
-  float normal(std::uint32_t i, int k) const {
-    return std::bit_cast<float>(k == 0 ? slots[i].word : k == 1 ? slots[i + 1].head : slots[i + 1].word);
-  }
-  float plane_d(std::uint32_t i) const { return std::bit_cast<float>(slots[i + 2].head); }
-  float plane_eps(std::uint32_t i) const { return std::bit_cast<float>(slots[i + 2].word); }
 };
 
 /// The compact layout of `flat` (validated by the caller). Every kd split,

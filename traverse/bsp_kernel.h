@@ -10,7 +10,6 @@
 /// Everything inline lives in the ISA inline namespace of simd.h (ODR: the
 /// AVX-512 copy of an inline function must never serve the baseline caller).
 
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -124,9 +123,8 @@ inline void kd_cut(float split, F o_k, F inv_k, F& near_hi, F& far_lo) {
 template <typename F>
 inline F plane_cut(const CompactBspSlot* n, const F (&o)[3], const F (&dir)[3], F err_o, F err_d,
                    F t0, F t1, F& near_hi, F& far_lo) {
-  const float n0 = std::bit_cast<float>(n[0].word), n1 = std::bit_cast<float>(n[1].head),
-              n2 = std::bit_cast<float>(n[1].word), d = std::bit_cast<float>(n[2].head),
-              eps = std::bit_cast<float>(n[2].word);
+  const float n0 = n->plane_normal(0), n1 = n->plane_normal(1), n2 = n->plane_normal(2), d = n->plane_d(),
+              eps = n->plane_eps();
   const F a = ((n0 * o[0] + n1 * o[1]) + n2 * o[2]) + d;
   F b = (n0 * dir[0] + n1 * dir[1]) + n2 * dir[2];
   b = gabs(b) < kTiny ? F{} : b;

@@ -85,9 +85,8 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
       const bool flip = cut_node<kCount>(n, rc, tmin, tmax, near_hi, far_lo, c);
       const std::uint32_t first = node + n->slots(), second = n->second_child();
       const std::uint32_t near = flip ? second : first, far = flip ? first : second;
-      // Empty bits: first child at bit 3, second at bit 4 (bsp_compact.h).
-      const std::uint32_t h = n->head;
-      const bool near_empty = (h >> (3 + flip)) & 1u, far_empty = (h >> (4 - flip)) & 1u;
+      const bool near_empty = flip ? n->second_empty() : n->first_empty();
+      const bool far_empty = flip ? n->first_empty() : n->second_empty();
       const bool go_near = !(near_hi < tmin) && !near_empty, go_far = !(far_lo > tmax) && !far_empty;  // NaN: both
       if (go_far) {
         const float far_min = far_lo > tmin ? far_lo : tmin;
