@@ -6,10 +6,15 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
+#include <functional>
 #include <memory>
 
 #include "apps/cli_common.h"
 #include "apps/progress.h"
+#include "builder/bsp_face_hits.h"
+#include "builder/bsp_file.h"
+#include "builder/tree_file.h"
+#include "geometry/error.h"
 #include "geometry/ray_io.h"
 
 namespace bsprt::cli {
@@ -20,7 +25,28 @@ struct TraceArgs {
   TraceOptions trace;
   bool json = false;
   bool stats = false;
+  bool face_hits = false;
 };
+
+/// --face-hits: how many nearest hits a face-plane split proves
+/// (builder/bsp_face_hits.h, docs/certified-epsilons.md §8).
+struct FaceHitFigures {
+  FaceProofStats tree;
+  std::uint64_t proven = 0;
+};
+
+FaceHitFigures count_face_hits(const TraceArgs& a, const TriangleSoup& soup, const std::vector<Hit>& hits) {
+  if (a.trace.tree.empty() || TreeFileReader(a.trace.tree).kind() != TreeKind::Bsp)
+    throw UsageError("--face-hits needs --tree with a BSP tree file (bsprt build --accel bsp)");
+  const BspTree exact = read_bsp_file(a.trace.tree, soup);
+  const FaceHitLocator locator(exact, soup);
+  tbb::combinable<std::uint64_t> proven(0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hits.size(), 4096), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i < r.end(); ++i)
+      proven.local() += locator.proving_node(hits[i]) != FaceHitLocator::kNone;
+  });
+  return {locator.stats(), proven.combine(std::plus<>())};
+}
 
 /// Traces all rays in parallel blocks; returns the summed counters.
 RayCounters trace_all(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits,
@@ -48,6 +74,7 @@ void run(const TraceArgs& a) {
   const RayCounters c = trace_all(*tracer, rays, hits, a.trace.packets, a.stats);
   const auto t2 = std::chrono::steady_clock::now();
   write_hits(a.hits, hits);
+  const FaceHitFigures face = a.face_hits ? count_face_hits(a, soup, hits) : FaceHitFigures{};
 
   std::size_t nhit = 0;
   for (const Hit& h : hits) nhit += h.hit();
@@ -63,6 +90,11 @@ void run(const TraceArgs& a) {
       fmt::print(", \"per_ray\": {{\"kd_node_visits\": {:.4f}, \"bsp_node_visits\": {:.4f}, "
                  "\"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}}}",
                  c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n);
+    if (a.face_hits)
+      fmt::print(", \"face_hits\": {{\"proven_hits\": {}, \"face_nodes\": {}, \"proving_nodes\": {}, "
+                 "\"inner_nodes\": {}, \"seconds\": {:.3f}}}",
+                 face.proven, face.tree.face_nodes, face.tree.proving_nodes, face.tree.inner_nodes,
+                 face.tree.seconds);
     fmt::print("}}\n");
     return;
   }
@@ -71,6 +103,14 @@ void run(const TraceArgs& a) {
   if (a.stats)
     fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests\n",
                c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n);
+  if (a.face_hits) {
+    fmt::print("face planes: {} of {} inner nodes split by a triangle's own face plane, {} with the cross-section "
+               "inside that triangle (exact, {:.2f} s)\n",
+               face.tree.face_nodes, face.tree.inner_nodes, face.tree.proving_nodes, face.tree.seconds);
+    fmt::print("face hits: {} of {} hits ({:.2f} %, {:.4f} per ray) lie on such a cross-section: the traversal "
+               "could report them from the plane's t\n",
+               face.proven, nhit, nhit ? 100.0 * double(face.proven) / double(nhit) : 0.0, double(face.proven) / n);
+  }
 }
 
 }  // namespace
@@ -84,6 +124,8 @@ void register_trace(CLI::App& app) {
   add_trace_options(*cmd, args->trace, "embree");
   cmd->add_flag("--json", args->json, "print one JSON object instead of text");
   cmd->add_flag("--stats", args->stats, "count and print node visits and triangle tests per ray");
+  cmd->add_flag("--face-hits", args->face_hits,
+                "bsp: count hits that a split on the hit triangle's own face plane proves (needs --tree)");
   cmd->callback([args] { run(*args); });
 }
 

@@ -149,6 +149,30 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
   const Run kind = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp --tree " + kd);
   CHECK(kind.status == 1);
   CHECK(kind.output.find("kd-tree") != std::string::npos);
+
+  // --face-hits: counts from the exact tree in the file, consistent with the hits.
+  const Run fh = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp --tree " +
+                           tree + " --json --face-hits");
+  INFO(fh.output);
+  REQUIRE(fh.status == 0);
+  const auto field = [&](const std::string& name) {
+    const std::size_t at = fh.output.find("\"" + name + "\": ");
+    REQUIRE(at != std::string::npos);
+    return std::stoull(fh.output.substr(at + name.size() + 4));
+  };
+  const auto hits = field("hits"), proven = field("proven_hits"), face = field("face_nodes"),
+             proving = field("proving_nodes"), inner = field("inner_nodes");
+  CHECK(hits > 0);
+  CHECK(proven <= hits);
+  CHECK(proving <= face);
+  CHECK(face <= inner);
+  CHECK(proving > 0);
+  for (const std::string& bad : {std::string("--accel bsp"), "--accel kd --tree " + kd}) {
+    const Run r = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --face-hits " + bad);
+    INFO(r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find("--face-hits needs --tree") != std::string::npos);
+  }
 }
 
 TEST_CASE("build --accel bsp with other SAH constants is certified and equals brute force and rejects bad values", "[cli]") {
