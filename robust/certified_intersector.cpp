@@ -145,6 +145,12 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
   if (!is_valid(ray)) return;
   for (const std::uint32_t prim : prims) {
     if (counters) ++counters->triangle_tests;
+    // The nearest triangle so far, met again in another leaf (a triangle is
+    // listed in every leaf it touches): test_one is a function of the ray and
+    // the triangle alone, so it would return the same candidate, which is not
+    // nearer than itself. Without this, the equal enclosures would send every
+    // such repeat to the exact comparison below (two rational t's).
+    if (best.hit.hit() && prim == best.hit.prim) continue;
     const auto tri = soup_.corners(prim);
     std::optional<Candidate> c = test_one(ray, tri, fallbacks_);
     if (!c) continue;
