@@ -35,9 +35,13 @@ struct FaceHitFigures {
   std::uint64_t proven = 0;
 };
 
-FaceHitFigures count_face_hits(const TraceArgs& a, const TriangleSoup& soup, const std::vector<Hit>& hits) {
+/// Checked before any ray is traced.
+void check_face_hits_usage(const TraceArgs& a) {
   if (a.trace.tree.empty() || TreeFileReader(a.trace.tree).kind() != TreeKind::Bsp)
     throw UsageError("--face-hits needs --tree with a BSP tree file (bsprt build --accel bsp)");
+}
+
+FaceHitFigures count_face_hits(const TraceArgs& a, const TriangleSoup& soup, const std::vector<Hit>& hits) {
   const BspTree exact = read_bsp_file(a.trace.tree, soup);
   const FaceHitLocator locator(exact, soup);
   tbb::combinable<std::uint64_t> proven(0);
@@ -65,6 +69,7 @@ RayCounters trace_all(const Tracer& tracer, const std::vector<Ray>& rays, std::v
 
 void run(const TraceArgs& a) {
   const auto threads = limit_threads(a.trace.threads);
+  if (a.face_hits) check_face_hits_usage(a);
   const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, !a.json);
   const std::vector<Ray> rays = read_rays(a.rays);
   const auto t0 = std::chrono::steady_clock::now();

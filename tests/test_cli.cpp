@@ -168,10 +168,13 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
   CHECK(face <= inner);
   CHECK(proving > 0);
   for (const std::string& bad : {std::string("--accel bsp"), "--accel kd --tree " + kd}) {
-    const Run r = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --face-hits " + bad);
+    const std::string out = temp_path("face_hits_usage.hits");
+    std::filesystem::remove(out);
+    const Run r = bsprt_cli("trace " + scene + " " + rays + " -o " + out + " --face-hits " + bad);
     INFO(r.output);
     CHECK(r.status == 2);
     CHECK(r.output.find("--face-hits needs --tree") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(out));  // refused before tracing
   }
 }
 
