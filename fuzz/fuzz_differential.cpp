@@ -1,21 +1,29 @@
 // Differential libFuzzer harness: bytes -> a small triangle soup (<= 12
 // triangles over a pool of 8 vertices whose coordinates come from a small grid
 // of floats, so duplicates, shared edges, coplanar and degenerate triangles are
-// common) and up to 16 rays aimed at pool vertices and edge points. Builds
-// brute, kd, bsp, bsp-certified and the exact reference and traps when
+// common) and up to 16 rays aimed at pool vertices and edge points, some made
+// special (a direction component ±0, subnormal, huge, infinite or NaN; the
+// direction scaled by 2^-100 or 2^100; a segment starting behind the origin).
+// Builds brute, kd, bsp, bsp-certified and the exact reference and traps when
 //   - bsp-certified differs from the exact reference (lost, extra, farther or
 //     nearer; a tie on another triangle at the same t is allowed), or
 //   - kd or bsp differ from brute force beyond ties: all three run the same
 //     float watertight test, so a tree may only change which of several
-//     triangles at the same t is reported.
+//     triangles at the same t is reported, or
+//   - kd or bsp packets (every width this CPU runs) differ from the same
+//     tree's single rays in any bit of any hit or in any counter: the packet
+//     kernels promise the single-ray sequence of nodes and leaves per lane.
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
+#include <limits>
 #include <span>
 #include <vector>
 
 #include "builder/accel_factory.h"
 #include "geometry/hit_compare.h"
 #include "robust/degenerate.h"
+#include "traverse/cpu_features.h"
 
 namespace {
 
@@ -47,6 +55,25 @@ bsprt::TriangleSoup make_soup(Reader& in) {
   return s;
 }
 
+/// Values a direction component may be replaced by: signed zeros (the ray
+/// stays in a slab), subnormals (flushed slopes), huge and infinite magnitudes
+/// and NaN (invalid rays: every tracer must report a miss).
+constexpr float kSpecial[8] = {0.0f, -0.0f, 1e-40f, -1e-40f, 0x1p70f, -3e38f,
+                               std::numeric_limits<float>::infinity(),
+                               std::numeric_limits<float>::quiet_NaN()};
+
+/// Half of the rays stay ordinary (mode 0-3); the others get one change.
+void make_special(bsprt::Ray& r, std::uint8_t e) {
+  const int axis = (e >> 3) % 3;
+  switch (e & 7) {
+    case 4: r.dir[axis] = kSpecial[(e >> 5) & 1]; break;   // axis-parallel component
+    case 5: r.dir[axis] = kSpecial[(e >> 5) & 7]; break;   // any special value
+    case 6: r.dir = r.dir * ((e & 32) ? 0x1p-100f : 0x1p100f); break;  // tiny or huge direction
+    case 7: r.tnear = (e & 32) ? -1e30f : -0.5f; r.tfar = (e & 64) ? 0.75f : r.tfar; break;
+    default: break;
+  }
+}
+
 std::vector<bsprt::Ray> make_rays(Reader& in, const bsprt::TriangleSoup& s) {
   std::vector<bsprt::Ray> rays;
   while (!in.empty() && rays.size() < 16) {
@@ -56,6 +83,7 @@ std::vector<bsprt::Ray> make_rays(Reader& in, const bsprt::TriangleSoup& s) {
     const bsprt::Vec3f p = s.vertices[d % 8], q = s.vertices[(d / 8) % 8];
     const float w = float(d / 64) / 4.0f;  // 0, 1/4, 1/2, 3/4 of the way to q: vertices and edge points
     r.dir = (p + (q - p) * w) - r.org;
+    make_special(r, in.next());
     rays.push_back(r);
   }
   return rays;
@@ -79,6 +107,34 @@ void expect_agree(const char* what, std::span<const bsprt::Hit> ref, std::span<c
   __builtin_trap();
 }
 
+/// Packets of every width this CPU runs equal the same tracer's single rays bit
+/// for bit, hits and counters.
+void expect_packets_equal(const std::string& accel, const bsprt::TriangleSoup& s, std::span<const bsprt::Ray> rays) {
+  bsprt::AccelOptions o;
+  o.threads = 1;
+  const auto t = bsprt::make_tracer(accel, s, o);
+  std::vector<bsprt::Hit> single(rays.size());
+  bsprt::RayCounters cs;
+  t->trace_batch(rays, single, 1, &cs);
+  for (int w : {4, 8, 16}) {
+    if (int(bsprt::detected_isa()) < int(bsprt::isa_for_width(w))) continue;
+    std::vector<bsprt::Hit> packed(rays.size());
+    bsprt::RayCounters cp;
+    t->trace_batch(rays, packed, w, &cp);
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if (std::memcmp(&single[i], &packed[i], sizeof(bsprt::Hit)) != 0) {
+        std::fprintf(stderr, "%s packets of %d: ray %zu: single t=%a prim=%u, packet t=%a prim=%u\n", accel.c_str(),
+                     w, i, double(single[i].t), single[i].prim, double(packed[i].t), packed[i].prim);
+        __builtin_trap();
+      }
+    if (cp.rays != cs.rays || cp.kd_node_visits != cs.kd_node_visits || cp.bsp_node_visits != cs.bsp_node_visits ||
+        cp.leaf_visits != cs.leaf_visits || cp.triangle_tests != cs.triangle_tests) {
+      std::fprintf(stderr, "%s packets of %d: counters differ from single rays\n", accel.c_str(), w);
+      __builtin_trap();
+    }
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -91,5 +147,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   expect_agree("bsp-certified vs exact", exact, trace("bsp-certified", soup, rays));
   expect_agree("kd vs brute", brute, trace("kd", soup, rays));
   expect_agree("bsp vs brute", brute, trace("bsp", soup, rays));
+  expect_packets_equal("kd", soup, rays);
+  expect_packets_equal("bsp", soup, rays);
   return 0;
 }

@@ -7,6 +7,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/intersections.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -23,6 +24,35 @@ using FT = Epeck::FT;
 
 Epick::Point_3 to_epick(const Vec3f& p) { return {p.x, p.y, p.z}; }
 Epeck::Point_3 to_epeck(const Vec3f& p) { return {p.x, p.y, p.z}; }
+
+/// The direction of `ray` as an Epick vector, scaled by a power of two (the
+/// same ray) if needed, such that o + d rounds to nothing in double; nullopt
+/// when neither the direction itself nor the one scaled to the origin's
+/// magnitude qualifies. Epick's Ray_3 and Line_3 store the point o + d computed
+/// in double: when that sum rounds, the query is a slightly rotated ray whose
+/// candidate list may miss a triangle the exact ray touches, and when it rounds
+/// to o (a direction tiny against the origin) CGAL rejects the ray as
+/// degenerate. Each sum is checked with Knuth's TwoSum error term.
+std::optional<Epick::Vector_3> exact_candidate_direction(const Ray& ray) {
+  const auto scaled = [&](int shift) -> std::optional<Epick::Vector_3> {
+    double d[3];
+    for (int k = 0; k < 3; ++k) {
+      const double o = ray.org[k];
+      d[k] = std::ldexp(double(ray.dir[k]), shift);  // exact: doubles span far more than floats
+      const double s = o + d[k], bb = s - o, err = (o - (s - bb)) + (d[k] - bb);
+      if (err != 0.0) return std::nullopt;
+    }
+    return Epick::Vector_3(d[0], d[1], d[2]);
+  };
+  if (auto d = scaled(0)) return d;
+  double mo = 0.0, md = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    mo = std::max(mo, std::fabs(double(ray.org[k])));
+    md = std::max(md, std::fabs(double(ray.dir[k])));
+  }
+  if (mo == 0.0) return std::nullopt;  // unreachable: o = 0 makes every sum exact
+  return scaled(std::ilogb(mo) - std::ilogb(md));  // max|d| near max|o|
+}
 
 /// Exact ray parameter of point p on the ray o + t d (p is on the ray).
 FT param(const Epeck::Point_3& p, const Epeck::Point_3& o, const Epeck::Vector_3& d) {
@@ -117,14 +147,19 @@ Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
   Hit best;
   if (!is_valid(ray) || impl_->triangles.empty()) return best;
   // Candidates from the AABB tree (exact predicates): a ray when the segment
-  // starts at or after the origin, else the whole line.
+  // starts at or after the origin, else the whole line. When no exact Epick
+  // query exists (exact_candidate_direction), every triangle is a candidate:
+  // the exact tests below decide, only slower.
   std::vector<TriangleList::const_iterator> candidates;
   const Epick::Point_3 eo = to_epick(ray.org);
-  const Epick::Vector_3 ed(ray.dir.x, ray.dir.y, ray.dir.z);
-  if (ray.tnear >= 0.0f)
-    impl_->tree.all_intersected_primitives(Epick::Ray_3(eo, ed), std::back_inserter(candidates));
-  else
-    impl_->tree.all_intersected_primitives(Epick::Line_3(eo, ed), std::back_inserter(candidates));
+  if (const std::optional<Epick::Vector_3> ed = exact_candidate_direction(ray)) {
+    if (ray.tnear >= 0.0f)
+      impl_->tree.all_intersected_primitives(Epick::Ray_3(eo, *ed), std::back_inserter(candidates));
+    else
+      impl_->tree.all_intersected_primitives(Epick::Line_3(eo, *ed), std::back_inserter(candidates));
+  } else {
+    for (auto it = impl_->triangles.cbegin(); it != impl_->triangles.cend(); ++it) candidates.push_back(it);
+  }
   if (candidates.empty()) return best;
 
   const Epeck::Point_3 o = to_epeck(ray.org);

@@ -4,6 +4,8 @@
 
 #include "geometry/default_scene.h"
 #include "geometry/error.h"
+#include "robust/certified_intersector.h"
+#include "robust/exact_tracer.h"
 #include "stiff_util.h"
 
 using namespace bsprt;
@@ -57,3 +59,43 @@ TEST_CASE("tree file: a BSP plane that does not cut its cell is an InputError", 
   CHECK_THROWS_AS(make_tracer("bsp-certified", scene, o), InputError);
 }
 
+// Found by fuzz_differential once its rays got special directions (a direction
+// scaled by 2^-100): Epick's Ray_3(o, d) stores o + d rounded to double, which
+// is o itself when d is tiny against o; CGAL then threw "precondition
+// violation: ray is degenerate" out of the exact reference (Release builds,
+// without CGAL's preconditions, reported a miss).
+TEST_CASE("exact reference: a direction tiny against the origin is traced", "[regression]") {
+  TriangleSoup s;
+  add_tri(s, {-1, -1, 1}, {3, -1, 1}, {-1, 3, 1});
+  const ExactTracer exact(s);
+  const CertifiedBruteTracer certified(s);
+  const Ray r = ray_of({0.25f, 0.25f, -1.0f}, {0, 0, 0x1p-100f});  // -1 + 2^-100 rounds to -1 in double
+  for (const Tracer* t : {static_cast<const Tracer*>(&exact), static_cast<const Tracer*>(&certified)}) {
+    Hit h;
+    REQUIRE_NOTHROW(h = t->trace(r));
+    CHECK(h.prim == 0);
+    CHECK(h.t == 0x1p101f);  // 2 / 2^-100
+  }
+  Ray line = r;  // a segment starting behind the origin takes the Line_3 query
+  line.tnear = -1e30f;
+  CHECK(exact.trace(line).t == 0x1p101f);
+}
+
+// The same rounding without degeneracy, found while fixing the finding above:
+// o + d rounded to double rotated the candidate query ray, which then passed
+// below the edge that the exact ray hits, and the only triangle was lost.
+TEST_CASE("exact reference: candidates come from the exact ray when o + d rounds in double", "[regression]") {
+  TriangleSoup s;
+  const float x = 0x1p40f, y = 1.0f + 0x1p-23f;
+  add_tri(s, {x, y, -1}, {x, y, 1}, {x, 3, 0});  // lower edge at y = 1 + 2^-23
+  const ExactTracer exact(s);
+  const CertifiedBruteTracer certified(s);
+  // At t = 2^40 the ray is at (2^40, 1 + 2^-23, 0), the edge's midpoint; in
+  // double, 1 + 2^-63 rounds to 1.
+  const Ray r = ray_of({0, 1, 0}, {1, 0x1p-63f, 0});
+  for (const Tracer* t : {static_cast<const Tracer*>(&exact), static_cast<const Tracer*>(&certified)}) {
+    const Hit h = t->trace(r);
+    CHECK(h.prim == 0);
+    CHECK(h.t == 0x1p40f);
+  }
+}
