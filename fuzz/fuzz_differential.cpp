@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -89,12 +90,15 @@ std::vector<bsprt::Ray> make_rays(Reader& in, const bsprt::TriangleSoup& s) {
   return rays;
 }
 
-std::vector<bsprt::Hit> trace(const std::string& accel, const bsprt::TriangleSoup& s, std::span<const bsprt::Ray> rays) {
+std::unique_ptr<bsprt::Tracer> make(const std::string& accel, const bsprt::TriangleSoup& s) {
   bsprt::AccelOptions o;
   o.threads = 1;
-  const auto t = bsprt::make_tracer(accel, s, o);
+  return bsprt::make_tracer(accel, s, o);
+}
+
+std::vector<bsprt::Hit> trace(const bsprt::Tracer& t, std::span<const bsprt::Ray> rays) {
   std::vector<bsprt::Hit> hits;
-  for (const bsprt::Ray& r : rays) hits.push_back(t->trace(r));
+  for (const bsprt::Ray& r : rays) hits.push_back(t.trace(r));
   return hits;
 }
 
@@ -109,27 +113,24 @@ void expect_agree(const char* what, std::span<const bsprt::Hit> ref, std::span<c
 
 /// Packets of every width this CPU runs equal the same tracer's single rays bit
 /// for bit, hits and counters.
-void expect_packets_equal(const std::string& accel, const bsprt::TriangleSoup& s, std::span<const bsprt::Ray> rays) {
-  bsprt::AccelOptions o;
-  o.threads = 1;
-  const auto t = bsprt::make_tracer(accel, s, o);
+void expect_packets_equal(const char* accel, const bsprt::Tracer& t, std::span<const bsprt::Ray> rays) {
   std::vector<bsprt::Hit> single(rays.size());
   bsprt::RayCounters cs;
-  t->trace_batch(rays, single, 1, &cs);
+  t.trace_batch(rays, single, 1, &cs);
   for (int w : {4, 8, 16}) {
     if (int(bsprt::detected_isa()) < int(bsprt::isa_for_width(w))) continue;
     std::vector<bsprt::Hit> packed(rays.size());
     bsprt::RayCounters cp;
-    t->trace_batch(rays, packed, w, &cp);
+    t.trace_batch(rays, packed, w, &cp);
     for (std::size_t i = 0; i < rays.size(); ++i)
       if (std::memcmp(&single[i], &packed[i], sizeof(bsprt::Hit)) != 0) {
-        std::fprintf(stderr, "%s packets of %d: ray %zu: single t=%a prim=%u, packet t=%a prim=%u\n", accel.c_str(),
+        std::fprintf(stderr, "%s packets of %d: ray %zu: single t=%a prim=%u, packet t=%a prim=%u\n", accel,
                      w, i, double(single[i].t), single[i].prim, double(packed[i].t), packed[i].prim);
         __builtin_trap();
       }
     if (cp.rays != cs.rays || cp.kd_node_visits != cs.kd_node_visits || cp.bsp_node_visits != cs.bsp_node_visits ||
         cp.leaf_visits != cs.leaf_visits || cp.triangle_tests != cs.triangle_tests) {
-      std::fprintf(stderr, "%s packets of %d: counters differ from single rays\n", accel.c_str(), w);
+      std::fprintf(stderr, "%s packets of %d: counters differ from single rays\n", accel, w);
       __builtin_trap();
     }
   }
@@ -142,12 +143,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const bsprt::TriangleSoup soup = make_soup(in);
   const std::vector<bsprt::Ray> rays = make_rays(in, soup);
   if (rays.empty()) return 0;
-  const std::vector<bsprt::Hit> exact = trace("exact", soup, rays);
-  const std::vector<bsprt::Hit> brute = trace("brute", soup, rays);
-  expect_agree("bsp-certified vs exact", exact, trace("bsp-certified", soup, rays));
-  expect_agree("kd vs brute", brute, trace("kd", soup, rays));
-  expect_agree("bsp vs brute", brute, trace("bsp", soup, rays));
-  expect_packets_equal("kd", soup, rays);
-  expect_packets_equal("bsp", soup, rays);
+  const std::vector<bsprt::Hit> exact = trace(*make("exact", soup), rays);
+  const std::vector<bsprt::Hit> brute = trace(*make("brute", soup), rays);
+  expect_agree("bsp-certified vs exact", exact, trace(*make("bsp-certified", soup), rays));
+  const auto kd = make("kd", soup), bsp = make("bsp", soup);
+  expect_agree("kd vs brute", brute, trace(*kd, rays));
+  expect_agree("bsp vs brute", brute, trace(*bsp, rays));
+  expect_packets_equal("kd", *kd, rays);
+  expect_packets_equal("bsp", *bsp, rays);
   return 0;
 }
