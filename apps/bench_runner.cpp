@@ -255,7 +255,6 @@ RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays) {
   return sum;
 }
 
-
 bool bench_mode_is_certified(const std::string& mode) {
   return mode == "bsp-certified" || mode == "exact" || mode == "brute-certified";
 }

@@ -1,5 +1,6 @@
 #include "geometry/ray_gen.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -60,12 +61,7 @@ RaySetKind parse_ray_set(const std::string& name) {
 }
 
 std::vector<Ray> primary_rays(const Camera& cam, int width, int height) {
-  const CameraRays gen(cam, width, height);
-  std::vector<Ray> rays;
-  rays.reserve(std::size_t(width) * std::size_t(height));
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) rays.push_back(gen.ray(x, y));
-  return rays;
+  return tiled_primary_rays(cam, width, height, std::max({width, height, 1}));  // one tile: row-major
 }
 
 std::vector<Ray> tiled_primary_rays(const Camera& cam, int width, int height, int tile) {
