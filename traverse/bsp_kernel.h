@@ -63,8 +63,8 @@ struct BspRayConst {
   float dir[3];      ///< direction
   float inv[3];      ///< 1/dir_k; NaN when dir_k is subnormal or the ray is unsafe
   bool neg[3];       ///< sign bit of inv[k]: kd near child is the upper one
-  float err_o;       ///< certified error of n·o + d at t = 0 (inf: unsafe ray)
-  float err_d;       ///< certified error of n·dir, per unit of |t|
+  float err;         ///< err_o + err_d·T: certified error of n·(o + t·dir) + d for every t of
+                     ///< the clipped segment, T = max(|tmin|, |tmax|) (inf: unsafe ray)
   float tmin, tmax;  ///< ray segment clipped (conservatively) to the root cell
   bool live;         ///< valid ray with a non-empty clipped segment
 };
@@ -116,20 +116,21 @@ inline void kd_cut(float split, F o_k, F inv_k, F& near_hi, F& far_lo) {
 
 /// Plane node in slots n[0..2] (bsp_compact.h) (docs/certified-epsilons.md
 /// §2-3): a = fl(n·o + d), b = fl(n·dir)
-/// (flushed to +0 when subnormal), E = eps + err_o + err_d·max(|t0|, |t1|)
-/// bounds |exact plane(o + t·dir) − (a + b·t)| over the cell for every t in
-/// [t0, t1]. The first child (value <= 0) needs a + b·t <= E, the second
+/// (flushed to +0 when subnormal), E = eps + err (err: the ray's, BspRayConst)
+/// bounds |exact plane(o + t·dir) − (a + b·t)| over the cell for every t of
+/// the ray's clipped segment, hence of every node interval inside it. E does
+/// not depend on the node's interval, so consecutive plane steps do not wait
+/// on each other. The first child (value <= 0) needs a + b·t <= E, the second
 /// a + b·t >= −E. Returns the slope b: near is the first child iff b >= 0.
 template <typename F>
-inline F plane_cut(const CompactBspSlot* n, const F (&o)[3], const F (&dir)[3], F err_o, F err_d,
-                   F t0, F t1, F& near_hi, F& far_lo) {
+inline F plane_cut(const CompactBspSlot* n, const F (&o)[3], const F (&dir)[3], F err, F& near_hi,
+                   F& far_lo) {
   const float n0 = n->plane_normal(0), n1 = n->plane_normal(1), n2 = n->plane_normal(2), d = n->plane_d(),
               eps = n->plane_eps();
   const F a = ((n0 * o[0] + n1 * o[1]) + n2 * o[2]) + d;
   F b = (n0 * dir[0] + n1 * dir[1]) + n2 * dir[2];
   b = gabs(b) < kTiny ? F{} : b;
-  const F at0 = gabs(t0), at1 = gabs(t1);
-  const F e = (eps + err_o) + err_d * (at0 > at1 ? at0 : at1);
+  const F e = eps + err;
   const F inv = 1.0f / b;
   const F q_first = (e - a) * inv, q_second = (-e - a) * inv;
   const auto flip = b < 0.0f;
@@ -138,37 +139,60 @@ inline F plane_cut(const CompactBspSlot* n, const F (&o)[3], const F (&dir)[3], 
   return b;
 }
 
-/// Per-ray constants: reciprocals, error coefficients, and the segment clipped
-/// to the root box with widened slab crossings (NaN slabs, from a ray in a
-/// slab plane or a subnormal direction component, do not clip).
+/// Sign bit of x: a bool for float, a lane mask for SIMD vectors.
+inline bool sign_of(float x) { return std::signbit(x); }
+template <typename F>
+inline auto sign_of(F x) {
+  using M = decltype(x < x);
+  return reinterpret_cast<M>(x) < 0;
+}
+
+/// The arithmetic of bsp_ray_setup, written once for one ray (F = float,
+/// masks bool) and for W lanes (F = vfloat<W>, masks vmask<W>): the packet
+/// kernels run the same IEEE operations in the same order, so each lane's
+/// values are its single ray's bit for bit. In: origin, direction, and in
+/// tmin/tmax the ray's tnear/tfar. Out: reciprocals (NaN when dir_k is
+/// subnormal or the ray is unsafe), their sign bits, the segment clipped to
+/// the root box with widened slab crossings (NaN slabs, from a ray in a slab
+/// plane or a subnormal direction component, do not clip), and err (§3).
+template <typename F, typename M>
+inline void ray_setup_core(const F (&o)[3], const F (&dir)[3], const Box3f& root, bool certified,
+                           F (&inv)[3], M (&neg)[3], F& tmin, F& tmax, F& err) {
+  F mo{}, md{};
+  for (int k = 0; k < 3; ++k) {
+    const F ao = gabs(o[k]), ad = gabs(dir[k]);
+    mo = ao > mo ? ao : mo;
+    md = ad > md ? ad : md;
+  }
+  const auto safe = (mo <= kSafeMax) & (md <= kSafeMax) & (md >= kSafeMinDir);
+  const F nan = F{} + std::numeric_limits<float>::quiet_NaN();
+  for (int k = 0; k < 3; ++k) {
+    const auto normal_or_zero = (dir[k] == 0.0f) | (gabs(dir[k]) >= kTiny);
+    inv[k] = (safe & normal_or_zero) ? 1.0f / dir[k] : nan;
+    neg[k] = sign_of(inv[k]);
+  }
+  const F err_o = safe ? (certified ? kErrCoef * mo + kErrAbs : F{})
+                       : F{} + std::numeric_limits<float>::infinity();
+  const F err_d = certified ? kErrCoef * md + kErrAbs : F{};
+  for (int k = 0; k < 3; ++k) {
+    const F ta = (root.lo[k] - o[k]) * inv[k], tb = (root.hi[k] - o[k]) * inv[k];
+    const F enter = widen_dn(neg[k] ? tb : ta), exit = widen_up(neg[k] ? ta : tb);
+    tmin = enter > tmin ? enter : tmin;
+    tmax = exit < tmax ? exit : tmax;
+  }
+  const F at0 = gabs(tmin), at1 = gabs(tmax);
+  err = err_o + err_d * (at0 > at1 ? at0 : at1);
+}
+
+/// Per-ray constants of one ray (ray_setup_core); an invalid ray is not live.
 inline BspRayConst bsp_ray_setup(const Ray& ray, const Box3f& root, bool certified) {
   BspRayConst c{};
   c.tmin = ray.tnear;
   c.tmax = ray.tfar;
   c.live = is_valid(ray);
   if (!c.live) return c;
-  float mo = 0.0f, md = 0.0f;
-  for (int k = 0; k < 3; ++k) {
-    c.o[k] = ray.org[k];
-    c.dir[k] = ray.dir[k];
-    mo = gabs(c.o[k]) > mo ? gabs(c.o[k]) : mo;
-    md = gabs(c.dir[k]) > md ? gabs(c.dir[k]) : md;
-  }
-  const bool safe = mo <= kSafeMax && md <= kSafeMax && md >= kSafeMinDir;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (int k = 0; k < 3; ++k) {
-    const bool sub = c.dir[k] != 0.0f && gabs(c.dir[k]) < kTiny;
-    c.inv[k] = safe && !sub ? 1.0f / c.dir[k] : nan;
-    c.neg[k] = std::signbit(c.inv[k]);
-  }
-  c.err_o = !safe ? std::numeric_limits<float>::infinity() : certified ? kErrCoef * mo + kErrAbs : 0.0f;
-  c.err_d = certified ? kErrCoef * md + kErrAbs : 0.0f;
-  for (int k = 0; k < 3; ++k) {
-    const float ta = (root.lo[k] - c.o[k]) * c.inv[k], tb = (root.hi[k] - c.o[k]) * c.inv[k];
-    const float enter = widen_dn(c.neg[k] ? tb : ta), exit = widen_up(c.neg[k] ? ta : tb);
-    c.tmin = enter > c.tmin ? enter : c.tmin;
-    c.tmax = exit < c.tmax ? exit : c.tmax;
-  }
+  for (int k = 0; k < 3; ++k) c.o[k] = ray.org[k], c.dir[k] = ray.dir[k];
+  ray_setup_core(c.o, c.dir, root, certified, c.inv, c.neg, c.tmin, c.tmax, c.err);
   c.live = c.tmin <= c.tmax;
   return c;
 }

@@ -17,6 +17,7 @@
 /// Raw arrays only: no std:: templates are instantiated for this ISA.
 
 #include <cstdint>
+#include <limits>
 
 #include "traverse/bsp_kernel.h"
 #include "traverse/watertight_packet.h"
@@ -44,7 +45,7 @@ template <int W>
 struct BspPacketRay {
   vfloat<W> o[3], dir[3], inv[3];
   vmask<W> neg[3];
-  vfloat<W> err_o, err_d;
+  vfloat<W> err;
   vfloat<W> tmin, tmax;
   vmask<W> live;
 };
@@ -54,21 +55,21 @@ inline std::uint64_t lanes(vmask<W> m) {
   return std::uint64_t(__builtin_popcount(movemask<W>(m)));
 }
 
-/// Lanes from the scalar setup, so every value is the single ray's.
+/// bsp_ray_setup for W lanes at once (ray_setup_core on vectors). Lanes past
+/// `count` or with an invalid ray are not live; their other values are
+/// meaningless and never read.
 template <int W>
 inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count) {
   BspPacketRay<W> p{};
-  for (int i = 0; i < W; ++i) {
-    BspRayConst c{};
-    if (i < count) c = detail::bsp_ray_setup(rays[i], v.bounds, v.certified);
-    for (int k = 0; k < 3; ++k) {
-      p.o[k][i] = c.o[k], p.dir[k][i] = c.dir[k], p.inv[k][i] = c.inv[k];
-      p.neg[k][i] = c.neg[k] ? -1 : 0;
-    }
-    p.err_o[i] = c.err_o, p.err_d[i] = c.err_d;
-    p.tmin[i] = c.tmin, p.tmax[i] = c.tmax;
-    p.live[i] = c.live ? -1 : 0;
+  p.live = mask_false<W>();
+  for (int i = 0; i < count; ++i) {
+    const Ray& ray = rays[i];
+    for (int k = 0; k < 3; ++k) p.o[k][i] = ray.org[k], p.dir[k][i] = ray.dir[k];
+    p.tmin[i] = ray.tnear, p.tmax[i] = ray.tfar;
+    p.live[i] = is_valid(ray) ? -1 : 0;
   }
+  detail::ray_setup_core(p.o, p.dir, v.bounds, v.certified, p.inv, p.neg, p.tmin, p.tmax, p.err);
+  p.live &= p.tmin <= p.tmax;
   return p;
 }
 
@@ -90,11 +91,10 @@ inline void packet_leaf(const BspView& v, const CompactBspSlot& n, const Waterti
 /// The node step for all lanes: conservative near_hi / far_lo, and the lanes
 /// whose near child is the second one.
 template <int W>
-inline vmask<W> cut_node(const CompactBspSlot& n, const BspPacketRay<W>& r, vfloat<W> tmin,
-                         vfloat<W> tmax, vfloat<W>& near_hi, vfloat<W>& far_lo) {
+inline vmask<W> cut_node(const CompactBspSlot& n, const BspPacketRay<W>& r, vfloat<W>& near_hi,
+                         vfloat<W>& far_lo) {
   if (n.is_plane()) {
-    const vfloat<W> b = detail::plane_cut<vfloat<W>>(&n, r.o, r.dir, r.err_o, r.err_d, tmin, tmax,
-                                                     near_hi, far_lo);
+    const vfloat<W> b = detail::plane_cut<vfloat<W>>(&n, r.o, r.dir, r.err, near_hi, far_lo);
     return b < 0.0f;
   }
   const int k = n.axis();
@@ -116,37 +116,46 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPa
     bool leaf = true;
     while (!n->is_leaf()) {
       vfloat<W> near_hi, far_lo;
-      const vmask<W> flip = cut_node<W>(*n, r, tmin, tmax, near_hi, far_lo);
-      const unsigned am = movemask<W>(active), fm = movemask<W>(active & flip);
-      bool fl = fm != 0;
-      if (fl && fm != am) {  // disagreeing lanes redo this node later
-        fl = (fm & (am & (0u - am))) != 0;  // the lowest active lane decides
-        const vmask<W> keep = fl ? (active & flip) : (active & ~flip);
-        stack[sp++] = {node, tmin, tmax, active & ~keep, mask_false<W>()};
-        active = keep;
+      const vmask<W> flip = cut_node<W>(*n, r, near_hi, far_lo);  // per lane: near is the second child
+      // Each lane's single-ray decision, in terms of the first and second child.
+      const vmask<W> go_own_near = active & ~(near_hi < tmin), go_own_far = active & ~(far_lo > tmax);
+      const vfloat<W> near_max = near_hi < tmax ? near_hi : tmax;
+      const vfloat<W> far_min = far_lo > tmin ? far_lo : tmin;
+      // A child that lists no triangle is not stored (bsp_compact.h): no lane goes there.
+      vmask<W> go1 = n->first_empty() ? mask_false<W>() : (flip ? go_own_far : go_own_near);
+      vmask<W> go2 = n->second_empty() ? mask_false<W>() : (flip ? go_own_near : go_own_far);
+      // Only lanes entering both children care about the order: when they
+      // disagree, those not agreeing with the lowest of them redo this node later.
+      const unsigned bm = movemask<W>(go1 & go2), bfm = movemask<W>(go1 & go2 & flip);
+      const unsigned am = movemask<W>(active);
+      const bool fl = bm != 0 ? (bfm & (bm & (0u - bm))) != 0 : (movemask<W>(active & flip) & (am & (0u - am))) != 0;
+      if (bfm != 0 && bfm != bm) {
+        const vmask<W> redo = go1 & go2 & (fl ? ~flip : flip);
+        stack[sp++] = {node, tmin, tmax, redo, mask_false<W>()};
+        active &= ~redo, go1 &= ~redo, go2 &= ~redo;
       }
       if constexpr (kCount) {
         if (n->is_plane()) c->bsp_node_visits += lanes<W>(active);
         else c->kd_node_visits += lanes<W>(active);
       }
+      // Each lane keeps its own child intervals: [tmin, near_max] for its near child,
+      // [far_min, tmax] for its far one.
+      const vfloat<W> lo1 = flip ? far_min : tmin, hi1 = flip ? tmax : near_max;
+      const vfloat<W> lo2 = flip ? tmin : far_min, hi2 = flip ? near_max : tmax;
       const std::uint32_t first = node + n->slots(), second = n->second_child();
       const std::uint32_t near = fl ? second : first, far = fl ? first : second;
-      // A child that lists no triangle is not stored (bsp_compact.h): no lane goes there.
-      const bool near_empty = fl ? n->second_empty() : n->first_empty();
-      const bool far_empty = fl ? n->first_empty() : n->second_empty();
-      const vmask<W> go_near = near_empty ? mask_false<W>() : active & ~(near_hi < tmin);
-      const vmask<W> go_far = far_empty ? mask_false<W>() : active & ~(far_lo > tmax);
-      const vfloat<W> near_max = near_hi < tmax ? near_hi : tmax;
-      const vfloat<W> far_min = far_lo > tmin ? far_lo : tmin;
+      const vmask<W> go_near = fl ? go2 : go1, go_far = fl ? go1 : go2;
       if (any<W>(go_far)) {
+        const vfloat<W> far_lo_t = fl ? lo1 : lo2, far_hi_t = fl ? hi1 : hi2;
         if (any<W>(go_near)) {
-          stack[sp++] = {far, far_min, tmax, go_far, go_far & go_near};
-          node = near, tmax = near_max, active = go_near;
+          // Lanes entering only the far child wait as direct entries (no cull, no clamp).
+          stack[sp++] = {far, far_lo_t, far_hi_t, go_far, go_far & go_near};
+          node = near, tmin = fl ? lo2 : lo1, tmax = fl ? hi2 : hi1, active = go_near;
         } else {
-          node = far, tmin = far_min, active = go_far;
+          node = far, tmin = far_lo_t, tmax = far_hi_t, active = go_far;
         }
       } else if (any<W>(go_near)) {
-        node = near, tmax = near_max, active = go_near;
+        node = near, tmin = fl ? lo2 : lo1, tmax = fl ? hi2 : hi1, active = go_near;
       } else {
         leaf = false;
         break;

@@ -46,12 +46,11 @@ inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray&
 /// One inner node: the near child's upper end and the far child's lower end
 /// of the ray interval, and whether near is the second child.
 template <bool kCount>
-inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float tmin, float tmax,
-                     float& near_hi, float& far_lo, RayCounters* c) {
+inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near_hi, float& far_lo,
+                     RayCounters* c) {
   if (n->is_plane()) {
     if constexpr (kCount) ++c->bsp_node_visits;
-    const float b = detail::plane_cut<float>(n, rc.o, rc.dir, rc.err_o, rc.err_d, tmin, tmax,
-                                             near_hi, far_lo);
+    const float b = detail::plane_cut<float>(n, rc.o, rc.dir, rc.err, near_hi, far_lo);
     return b < 0.0f;
   }
   if constexpr (kCount) ++c->kd_node_visits;
@@ -82,7 +81,7 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
     bool leaf = true;
     while (!n->is_leaf()) {
       float near_hi, far_lo;
-      const bool flip = cut_node<kCount>(n, rc, tmin, tmax, near_hi, far_lo, c);
+      const bool flip = cut_node<kCount>(n, rc, near_hi, far_lo, c);
       const std::uint32_t first = node + n->slots(), second = n->second_child();
       const std::uint32_t near = flip ? second : first, far = flip ? first : second;
       const bool near_empty = flip ? n->second_empty() : n->first_empty();
