@@ -335,6 +335,44 @@ TEST_CASE("watertight: packets equal single rays on a random soup", "[watertight
   CHECK(hits > rays.size() / 10);
 }
 
+TEST_CASE("watertight: packets mixing invalid lanes and tied axes equal single rays", "[watertight][packet]") {
+  // The packet precomputation runs on vectors: the dominant axis must follow
+  // max_axis exactly where |dir| components tie, the winding swap where
+  // dir[kz] < 0, and invalid lanes must not disturb their valid neighbours.
+  std::mt19937 g(7);
+  TriangleSoup soup;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3f c{rand_in(g, -1, 1), rand_in(g, -1, 1), rand_in(g, -1, 1)};
+    add_tri(soup, c + rand_dir(g) * 0.4f, c + rand_dir(g) * 0.4f, c + rand_dir(g) * 0.4f);
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<Ray> invalid = {
+      make_ray({nan, 0, 0}, {1, 0, 0}),          make_ray({0, 0, 0}, {kInf, 1, 0}),
+      make_ray({0, 0, 0}, {0, 0, 0}),            make_ray({0, 0, 0}, {1, 1, 1}, 2.0f, 1.0f),
+      make_ray({0, 0, 0}, {1, 1, 1}, nan, kInf), make_ray({0, 0, 0}, {1, 1, 1}, 0.0f, nan)};
+  std::vector<Ray> rays;
+  std::size_t tied = 0;
+  for (int i = 0; i < 4000; ++i) {
+    // Components drawn from {±a, ±b, 0} so that two or three magnitudes tie.
+    const float a = rand_in(g, 0.2f, 1.0f), b = rand_in(g, 0.2f, 1.0f);
+    const float pool[5] = {a, -a, b, -b, 0.0f};
+    Vec3f d{pool[g() % 5], pool[g() % 5], pool[g() % 5]};
+    if (d.x == 0 && d.y == 0 && d.z == 0) d.z = -a;
+    const float m[3] = {std::abs(d.x), std::abs(d.y), std::abs(d.z)};
+    tied += (m[0] == m[1] || m[0] == m[2] || m[1] == m[2]) ? 1 : 0;
+    const Vec3f o{rand_in(g, -1, 1), rand_in(g, -1, 1), rand_in(g, -1, 1)};
+    rays.push_back(make_ray(o - d * 3.0f, d));
+    if (i % 3 == 0) rays.push_back(invalid[std::size_t(i / 3) % invalid.size()]);
+  }
+  CHECK(tied > 2000);
+  check_packets_match(soup, rays);
+  const BruteForceTracer brute(soup);
+  std::size_t hits = 0;
+  for (const Ray& r : rays) hits += brute.trace(r).hit() ? 1 : 0;
+  CHECK(hits > rays.size() / 10);
+  for (const Ray& r : invalid) CHECK_FALSE(brute.trace(r).hit());
+}
+
 TEST_CASE("watertight: batch widths are checked", "[watertight][packet]") {
   TriangleSoup soup = make_tetra();
   std::vector<Ray> rays(5, make_ray({1, 1, 1}, {1, 0, 0}));

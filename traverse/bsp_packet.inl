@@ -60,16 +60,15 @@ inline std::uint64_t lanes(vmask<W> m) {
 /// meaningless and never read.
 template <int W>
 inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count) {
-  BspPacketRay<W> p{};
-  p.live = mask_false<W>();
+  BspPacketRay<W> p{};  // lanes past count: zero direction, so not valid
   for (int i = 0; i < count; ++i) {
     const Ray& ray = rays[i];
     for (int k = 0; k < 3; ++k) p.o[k][i] = ray.org[k], p.dir[k][i] = ray.dir[k];
     p.tmin[i] = ray.tnear, p.tmax[i] = ray.tfar;
-    p.live[i] = is_valid(ray) ? -1 : 0;
   }
+  const vmask<W> valid = valid_lanes<W>(p.o, p.dir, p.tmin, p.tmax);
   detail::ray_setup_core(p.o, p.dir, v.bounds, v.certified, p.inv, p.neg, p.tmin, p.tmax, p.err);
-  p.live &= p.tmin <= p.tmax;
+  p.live = valid & (p.tmin <= p.tmax);
   return p;
 }
 

@@ -74,42 +74,61 @@ inline Ray packet_lane(const RayPacket<W>& p, int lane) {
   return r;
 }
 
-/// Sets lane `lane` of `p` from the scalar precomputation `r`.
+/// is_valid (geometry/ray.h) of W lanes: finite origin and direction, a
+/// non-zero direction, tnear <= tfar (false when either is NaN).
 template <int W>
-inline void set_lane(WatertightPacket<W>& p, int lane, const WatertightRay& r) {
-  for (int k = 0; k < 3; ++k) p.org[k][lane] = r.org[k];
-  p.sx[lane] = r.sx;
-  p.sy[lane] = r.sy;
-  p.sz[lane] = r.sz;
-  p.tnear[lane] = r.tnear;
-  p.tfar[lane] = r.tfar;
-  p.kx0[lane] = r.kx == 0 ? -1 : 0;
-  p.kx1[lane] = r.kx == 1 ? -1 : 0;
-  p.ky0[lane] = r.ky == 0 ? -1 : 0;
-  p.ky1[lane] = r.ky == 1 ? -1 : 0;
-  p.kz0[lane] = r.kz == 0 ? -1 : 0;
-  p.kz1[lane] = r.kz == 1 ? -1 : 0;
-  p.valid[lane] = r.valid ? -1 : 0;
+inline vmask<W> valid_lanes(const vfloat<W> (&org)[3], const vfloat<W> (&dir)[3], vfloat<W> tnear,
+                            vfloat<W> tfar) {
+  const float big = std::numeric_limits<float>::max();
+  vmask<W> valid = tnear <= tfar;
+  for (int k = 0; k < 3; ++k) valid &= (abs<W>(org[k]) <= big) & (abs<W>(dir[k]) <= big);
+  return valid & ((dir[0] != 0.0f) | (dir[1] != 0.0f) | (dir[2] != 0.0f));
 }
 
+namespace watertight_detail {
+/// Component k[i] of a per lane.
+template <int W>
+inline vfloat<W> pick(const vfloat<W> (&a)[3], vint<W> k) {
+  return k == 0 ? a[0] : (k == 1 ? a[1] : a[2]);
+}
+}  // namespace watertight_detail
+
 /// Precomputes a packet from up to W rays (rays.size() <= W); lanes past the
-/// end are invalid. Per-lane values come from the scalar watertight_precompute.
+/// end are invalid. watertight_precompute on vectors: the same axis choice
+/// (max_axis) and the same divisions, so each valid lane equals the scalar
+/// precomputation; invalid lanes are never tested.
 template <int W>
 inline WatertightPacket<W> watertight_precompute_packet(std::span<const Ray> rays) {
   WatertightPacket<W> p{};
-  p.valid = mask_false<W>();
-  bool first = true;
+  vfloat<W> dir[3] = {};  // lanes past the end: zero direction, so not valid
+  p.tfar = splat<W>(std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < rays.size() && i < std::size_t(W); ++i) {
+    for (int k = 0; k < 3; ++k) p.org[k][i] = rays[i].org[k], dir[k][i] = rays[i].dir[k];
+    p.tnear[i] = rays[i].tnear, p.tfar[i] = rays[i].tfar;
+  }
+  p.valid = valid_lanes<W>(p.org, dir, p.tnear, p.tfar);
+  // max_axis: x if |x| >= |y| and |x| >= |z|, else y if |y| >= |z|, else z.
+  const vfloat<W> ax = abs<W>(dir[0]), ay = abs<W>(dir[1]), az = abs<W>(dir[2]);
+  const vmask<W> xy = ax >= ay;
+  const vint<W> kz = (xy & (ax >= az)) ? splat_int<W>(0) : ((~xy & (ay >= az)) ? splat_int<W>(1) : splat_int<W>(2));
+  vint<W> kx = kz == 2 ? splat_int<W>(0) : kz + 1;
+  vint<W> ky = kx == 2 ? splat_int<W>(0) : kx + 1;
+  const vfloat<W> dz = watertight_detail::pick<W>(dir, kz);
+  const vmask<W> swap = dz < 0.0f;
+  const vint<W> kx_swapped = swap ? ky : kx;
+  ky = swap ? kx : ky;
+  kx = kx_swapped;
+  p.sx = watertight_detail::pick<W>(dir, kx) / dz;
+  p.sy = watertight_detail::pick<W>(dir, ky) / dz;
+  p.sz = 1.0f / dz;
+  p.kx0 = kx == 0, p.kx1 = kx == 1, p.ky0 = ky == 0, p.ky1 = ky == 1, p.kz0 = kz == 0, p.kz1 = kz == 1;
+  const unsigned vm = movemask<W>(p.valid);
   p.uniform = true;
-  for (int i = 0; i < W; ++i) {
-    WatertightRay r;  // invalid padding lane
-    if (std::size_t(i) < rays.size()) r = watertight_precompute(rays[i]);
-    set_lane(p, i, r);
-    if (!r.valid) continue;
-    if (first) {
-      p.kx = r.kx, p.ky = r.ky, p.kz = r.kz, first = false;
-    } else if (r.kx != p.kx || r.ky != p.ky || r.kz != p.kz) {
-      p.uniform = false;
-    }
+  if (vm != 0) {
+    const int i0 = __builtin_ctz(vm);
+    p.kx = kx[i0], p.ky = ky[i0], p.kz = kz[i0];
+    const vmask<W> same = (kx == p.kx) & (ky == p.ky) & (kz == p.kz);
+    p.uniform = (movemask<W>(same) & vm) == vm;
   }
   return p;
 }
