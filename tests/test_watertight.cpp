@@ -122,6 +122,24 @@ Vec3f rand_dir(std::mt19937& g) {
   }
 }
 
+/// n random triangles of about `size` around points of [-1, 1]^3.
+TriangleSoup random_soup(std::mt19937& g, int n, float size) {
+  TriangleSoup soup;
+  for (int i = 0; i < n; ++i) {
+    const Vec3f c{rand_in(g, -1, 1), rand_in(g, -1, 1), rand_in(g, -1, 1)};
+    add_tri(soup, c + rand_dir(g) * size, c + rand_dir(g) * size, c + rand_dir(g) * size);
+  }
+  return soup;
+}
+
+/// Rays of `rays` that hit `soup` (brute force).
+std::size_t brute_hits(const TriangleSoup& soup, const std::vector<Ray>& rays) {
+  const BruteForceTracer brute(soup);
+  std::size_t hits = 0;
+  for (const Ray& r : rays) hits += brute.trace(r).hit() ? 1 : 0;
+  return hits;
+}
+
 }  // namespace
 
 TEST_CASE("watertight: ray through the middle gives exact t, u, v", "[watertight]") {
@@ -311,11 +329,7 @@ TEST_CASE("watertight: closed solids never leak, even through vertices", "[water
 
 TEST_CASE("watertight: packets equal single rays on a random soup", "[watertight][packet]") {
   std::mt19937 g(42);
-  TriangleSoup soup;
-  for (int i = 0; i < 300; ++i) {
-    const Vec3f c{rand_in(g, -1, 1), rand_in(g, -1, 1), rand_in(g, -1, 1)};
-    add_tri(soup, c + rand_dir(g) * 0.3f, c + rand_dir(g) * 0.3f, c + rand_dir(g) * 0.3f);
-  }
+  TriangleSoup soup = random_soup(g, 300, 0.3f);
   // A degenerate one in the middle of it all, flagged as the loader would.
   add_tri(soup, {-1, -1, -1}, {0, 0, 0}, {1, 1, 1});
   soup.degenerate.back() = 1;
@@ -329,10 +343,7 @@ TEST_CASE("watertight: packets equal single rays on a random soup", "[watertight
     rays.push_back(make_ray({rand_in(g, -1, 1), rand_in(g, -1, 1), -3}, {rand_in(g, -0.2f, 0.2f), rand_in(g, -0.2f, 0.2f), 1}));
   rays.push_back(make_ray({0, 0, 0}, {0, 0, 0}));  // invalid, and the batch is not a multiple of 16
   check_packets_match(soup, rays);
-  std::size_t hits = 0;
-  const BruteForceTracer brute(soup);
-  for (const Ray& r : rays) hits += brute.trace(r).hit() ? 1 : 0;
-  CHECK(hits > rays.size() / 10);
+  CHECK(brute_hits(soup, rays) > rays.size() / 10);
 }
 
 TEST_CASE("watertight: packets mixing invalid lanes and tied axes equal single rays", "[watertight][packet]") {
@@ -340,11 +351,7 @@ TEST_CASE("watertight: packets mixing invalid lanes and tied axes equal single r
   // max_axis exactly where |dir| components tie, the winding swap where
   // dir[kz] < 0, and invalid lanes must not disturb their valid neighbours.
   std::mt19937 g(7);
-  TriangleSoup soup;
-  for (int i = 0; i < 200; ++i) {
-    const Vec3f c{rand_in(g, -1, 1), rand_in(g, -1, 1), rand_in(g, -1, 1)};
-    add_tri(soup, c + rand_dir(g) * 0.4f, c + rand_dir(g) * 0.4f, c + rand_dir(g) * 0.4f);
-  }
+  const TriangleSoup soup = random_soup(g, 200, 0.4f);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const std::vector<Ray> invalid = {
       make_ray({nan, 0, 0}, {1, 0, 0}),          make_ray({0, 0, 0}, {kInf, 1, 0}),
@@ -366,11 +373,8 @@ TEST_CASE("watertight: packets mixing invalid lanes and tied axes equal single r
   }
   CHECK(tied > 2000);
   check_packets_match(soup, rays);
-  const BruteForceTracer brute(soup);
-  std::size_t hits = 0;
-  for (const Ray& r : rays) hits += brute.trace(r).hit() ? 1 : 0;
-  CHECK(hits > rays.size() / 10);
-  for (const Ray& r : invalid) CHECK_FALSE(brute.trace(r).hit());
+  CHECK(brute_hits(soup, rays) > rays.size() / 10);
+  CHECK(brute_hits(soup, invalid) == 0);
 }
 
 TEST_CASE("watertight: batch widths are checked", "[watertight][packet]") {
