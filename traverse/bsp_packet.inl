@@ -114,6 +114,7 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPa
     const CompactBspSlot* n = &v.nodes[node];
     bool leaf = true;
     while (!n->is_leaf()) {
+      __builtin_prefetch(&v.nodes[n->second_child()]);  // as the single-ray step
       vfloat<W> near_hi, far_lo;
       const vmask<W> flip = cut_node<W>(*n, r, near_hi, far_lo);  // per lane: near is the second child
       // Each lane's single-ray decision, in terms of the first and second child.

@@ -80,6 +80,8 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
     const CompactBspSlot* n = &v.nodes[node];
     bool leaf = true;
     while (!n->is_leaf()) {
+      // The first child follows this node; fetch the second while t is computed.
+      __builtin_prefetch(&v.nodes[n->second_child()]);
       float near_hi, far_lo;
       const bool flip = cut_node<kCount>(n, rc, near_hi, far_lo, c);
       const std::uint32_t first = node + n->slots(), second = n->second_child();

@@ -103,6 +103,7 @@ void trace_packet(const KdView& v, const Ray* rays, int count, const bool neg[3]
   for (;;) {
     const KdNode* n = &v.nodes[node];
     while (!n->is_leaf()) {
+      __builtin_prefetch(&v.nodes[n->upper_child()]);  // as the single-ray step
       if constexpr (kCount) c->kd_node_visits += lanes<W>(active);
       const int k = n->axis();
       vfloat<W> tl, th;
