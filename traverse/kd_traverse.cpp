@@ -73,7 +73,7 @@ Hit trace_from(const KdView& v, const WatertightRay& wr, const float o[3],
   for (;;) {
     const KdNode* n = &v.nodes[node];
     while (!n->is_leaf()) {
-      __builtin_prefetch(&v.nodes[n->upper_child()]);  // the far child's fetch overlaps t
+      __builtin_prefetch(&v.nodes[n->upper_child()]);  // lines away (lower follows): fetch it while t is computed
       if constexpr (kCount) ++c->kd_node_visits;
       const int k = n->axis();
       const float t = (n->split - o[k]) * inv[k];
