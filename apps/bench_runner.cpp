@@ -170,7 +170,8 @@ BenchRow measure_mode(const BuiltMode& m, const std::vector<Ray>& rays, const st
   const int runs = bench_mode_is_certified(m.mode) ? 1 : o.runs;  // slow modes: one pass
   row.mrays_single = double(timed.size()) / time_trace(*m.tracer, timed, hits, 1, runs) * 1e-6;
   row.hits = std::size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.hit(); }));
-  row.packet_width = bench_mode_is_certified(m.mode) ? 1 : isa_width;
+  // Certified modes and box tops trace packets as single rays: no packet row.
+  row.packet_width = bench_mode_is_certified(m.mode) || m.mode.rfind("bsp-top", 0) == 0 ? 1 : isa_width;
   if (row.packet_width > 1)
     row.mrays_packet = double(timed.size()) / time_trace(*m.tracer, timed, hits, row.packet_width, o.runs) * 1e-6;
   const RayCounters c = count_work(*m.tracer, subset.empty() ? timed : subset);
@@ -256,7 +257,7 @@ RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays) {
 }
 
 bool bench_mode_is_certified(const std::string& mode) {
-  return mode == "bsp-certified" || mode == "exact" || mode == "brute-certified";
+  return mode == "bsp-certified" || mode == "bsp-top-certified" || mode == "exact" || mode == "brute-certified";
 }
 
 double median_t_ulps(const std::vector<Hit>& reference, const std::vector<Hit>& tested) {

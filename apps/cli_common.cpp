@@ -22,6 +22,10 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
                  "BSP builds: which triangles a leaf lists: area (positive-area overlap, the default) or closed "
                  "(every triangle touching the closed cell)")
       ->capture_default_str();
+  cmd.add_option("--top-slots", o.top_slots,
+                 "bsp-top: largest BSP subtree (8-byte slots) under one box of the box top")
+      ->check(CLI::Range(1u, 1u << 27))
+      ->capture_default_str();
   cmd.add_flag("--allow-nonfinite", o.allow_nonfinite,
                "keep triangles with NaN/Inf corners (flagged degenerate, never hit) instead of failing");
 }
@@ -65,6 +69,7 @@ std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& so
   options.tree_path = o.tree;
   options.threads = o.threads;
   options.bsp.membership = parse_membership(o.membership);
+  options.top_slots = o.top_slots;
   const bool building = o.tree.empty() && (o.accel == "kd" || o.accel.rfind("bsp", 0) == 0);
   std::unique_ptr<ProgressBar> bar;
   if (building && ProgressBar::stderr_is_terminal()) {

@@ -23,9 +23,11 @@ struct TraceOptions {
   int packets = 1;
   bool allow_nonfinite = false;
   std::string membership = "area";
+  std::uint32_t top_slots = 1024;
 };
 
-/// Adds --accel, --tree, --threads, --packets, --allow-nonfinite to `cmd`.
+/// Adds --accel, --tree, --threads, --packets, --membership, --top-slots,
+/// --allow-nonfinite to `cmd`.
 void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& default_accel);
 
 /// Loads SCENE, or the embedded default scene when `path` is empty or

@@ -93,8 +93,9 @@ void run(const TraceArgs& a) {
                tracer->name(), rays.size(), nhit, build_s, trace_s, mrays, a.trace.packets);
     if (a.stats)
       fmt::print(", \"per_ray\": {{\"kd_node_visits\": {:.4f}, \"bsp_node_visits\": {:.4f}, "
-                 "\"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}}}",
-                 c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n);
+                 "\"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}, \"box_node_visits\": {:.4f}}}",
+                 c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n,
+                 c.box_node_visits / n);
     if (a.face_hits)
       fmt::print(", \"face_hits\": {{\"proven_hits\": {}, \"face_nodes\": {}, \"proving_nodes\": {}, "
                  "\"inner_nodes\": {}, \"seconds\": {:.3f}}}",
@@ -106,8 +107,9 @@ void run(const TraceArgs& a) {
   fmt::print("accel {}: {} rays, {} hits, build {:.3f} s, trace {:.3f} s, {:.2f} Mrays/s\n", tracer->name(),
              rays.size(), nhit, build_s, trace_s, mrays);
   if (a.stats)
-    fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests\n",
-               c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n);
+    fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests{}\n",
+               c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n,
+               c.box_node_visits ? fmt::format(", {:.3f} box-top node visits", c.box_node_visits / n) : "");
   if (a.face_hits) {
     fmt::print("face planes: {} of {} inner nodes split by a triangle's own face plane, {} with the cross-section "
                "inside that triangle (exact, {:.2f} s)\n",

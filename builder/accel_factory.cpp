@@ -40,9 +40,11 @@ std::unique_ptr<Tracer> make_kd(const TriangleSoup& soup, const AccelOptions& op
 /// A BSP tracer whose leaves use the exact-decision test (owns that test).
 class CertifiedBspTracer final : public Tracer {
  public:
-  CertifiedBspTracer(FlatBspTree flat, const TriangleSoup& soup)
+  /// top_slots > 0: under a box top of subtrees of at most that many slots.
+  CertifiedBspTracer(FlatBspTree flat, const TriangleSoup& soup, std::uint32_t top_slots = 0)
       : exact_(soup), bsp_(std::move(flat), soup, BspEpsilon::Certified) {
     bsp_.set_exact_leaf(&exact_);
+    if (top_slots > 0) bsp_.set_box_top(build_box_top(bsp_.subtree_boxes(top_slots)));
   }
   std::string name() const override { return bsp_.name(); }
   Hit trace(const Ray& ray, RayCounters* counters) const override { return bsp_.trace(ray, counters); }
@@ -79,7 +81,7 @@ FlatBspTree load_or_build_bsp(const TriangleSoup& soup, const AccelOptions& opti
 
 }  // namespace
 
-std::vector<std::string> accel_names() { return {"brute", "brute-certified", "exact", "embree", "embree-fast", "kd", "bsp", "bsp-certified", "bsp-zero-eps"}; }
+std::vector<std::string> accel_names() { return {"brute", "brute-certified", "exact", "embree", "embree-fast", "kd", "bsp", "bsp-certified", "bsp-zero-eps", "bsp-top", "bsp-top-certified"}; }
 
 std::unique_ptr<Tracer> make_tracer(const std::string& accel, const TriangleSoup& soup,
                                     const AccelOptions& options) {
@@ -97,6 +99,13 @@ std::unique_ptr<Tracer> make_tracer(const std::string& accel, const TriangleSoup
   if (accel == "kd") return make_kd(soup, options);
   if (accel == "bsp") return make_bsp_tracer(soup, load_or_build_bsp(soup, options), BspEpsilon::Certified);
   if (accel == "bsp-zero-eps") return make_bsp_tracer(soup, load_or_build_bsp(soup, options), BspEpsilon::Zero);
+  if (accel == "bsp-top") {
+    auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(soup, options), soup, BspEpsilon::Certified);
+    bsp->set_box_top(build_box_top(bsp->subtree_boxes(options.top_slots)));
+    return bsp;
+  }
+  if (accel == "bsp-top-certified")
+    return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(soup, options), soup, options.top_slots);
   if (accel == "bsp-certified") return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(soup, options), soup);
   std::string names;
   for (const std::string& n : accel_names()) names += (names.empty() ? "" : ", ") + n;

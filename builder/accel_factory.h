@@ -23,6 +23,9 @@ struct AccelOptions {
   /// Called with (done, total) during long builds (the CLI draws a bar).
   std::function<void(double, double)> progress;
   BspConfig bsp;          ///< settings of an in-memory BSP build
+  /// bsp-top, bsp-top-certified: largest BSP subtree (in 8-byte slots) under
+  /// one box of the box top (traverse/bsp_boxtop.h).
+  std::uint32_t top_slots = 1024;
 };
 
 /// Accelerator names `make_tracer` accepts.

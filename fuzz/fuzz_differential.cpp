@@ -4,10 +4,12 @@
 // common) and up to 16 rays aimed at pool vertices and edge points, some made
 // special (a direction component ±0, subnormal, huge, infinite or NaN; the
 // direction scaled by 2^-100 or 2^100; a segment starting behind the origin).
-// Builds brute, kd, bsp, bsp-certified and the exact reference and traps when
-//   - bsp-certified differs from the exact reference (lost, extra, farther or
-//     nearer; a tie on another triangle at the same t is allowed), or
-//   - kd or bsp differ from brute force beyond ties: all three run the same
+// Builds brute, kd, bsp, bsp-certified, bsp-top and bsp-top-certified (box
+// tops over one-slot subtrees) and the exact reference and traps when
+//   - bsp-certified or bsp-top-certified differ from the exact reference (lost,
+//     extra, farther or nearer; a tie on another triangle at the same t is
+//     allowed), or
+//   - kd, bsp or bsp-top differ from brute force beyond ties: all run the same
 //     float watertight test, so a tree may only change which of several
 //     triangles at the same t is reported, or
 //   - kd or bsp packets (every width this CPU runs) differ from the same
@@ -90,9 +92,11 @@ std::vector<bsprt::Ray> make_rays(Reader& in, const bsprt::TriangleSoup& s) {
   return rays;
 }
 
-std::unique_ptr<bsprt::Tracer> make(const std::string& accel, const bsprt::TriangleSoup& s) {
+std::unique_ptr<bsprt::Tracer> make(const std::string& accel, const bsprt::TriangleSoup& s,
+                                     std::uint32_t top_slots = 1024) {
   bsprt::AccelOptions o;
   o.threads = 1;
+  o.top_slots = top_slots;
   return bsprt::make_tracer(accel, s, o);
 }
 
@@ -146,6 +150,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::vector<bsprt::Hit> exact = trace(*make("exact", soup), rays);
   const std::vector<bsprt::Hit> brute = trace(*make("brute", soup), rays);
   expect_agree("bsp-certified vs exact", exact, trace(*make("bsp-certified", soup), rays));
+  // Box tops of one-slot subtrees: every leaf under its own box, the deepest top.
+  expect_agree("bsp-top-certified vs exact", exact, trace(*make("bsp-top-certified", soup, 1), rays));
+  expect_agree("bsp-top vs brute", brute, trace(*make("bsp-top", soup, 1), rays));
   const auto kd = make("kd", soup), bsp = make("bsp", soup);
   expect_agree("kd vs brute", brute, trace(*kd, rays));
   expect_agree("bsp vs brute", brute, trace(*bsp, rays));

@@ -86,6 +86,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try_accel("kd", path);
   try_accel("bsp", path);
   try_accel("bsp-certified", path);
+  try_accel("bsp-top", path);
   std::remove(path.c_str());
   return 0;
 }

@@ -1,6 +1,6 @@
 #pragma once
 // Helpers of the stiff-case, watertightness and regression tests: build kd,
-// BSP (float and certified leaves) once per scene, trace ray sets with every
+// BSP (float and certified leaves, without and with a box top) once per scene, trace ray sets with every
 // mode, compare with the exact reference, and optionally append the figures
 // to a Markdown table (BSPRT_ROBUSTNESS_REPORT=path) for docs/robustness.md.
 #include <tbb/blocked_range.h>
@@ -27,8 +27,11 @@ namespace bsprt::test {
 /// sharing a flat tree built once with the float-leaf tracer.
 class CertifiedBsp final : public Tracer {
  public:
-  CertifiedBsp(FlatBspTree flat, const TriangleSoup& soup) : exact_(soup), bsp_(std::move(flat), soup) {
+  /// top_slots > 0: under a box top of subtrees of at most that many slots.
+  CertifiedBsp(FlatBspTree flat, const TriangleSoup& soup, std::uint32_t top_slots = 0)
+      : exact_(soup), bsp_(std::move(flat), soup) {
     bsp_.set_exact_leaf(&exact_);
+    if (top_slots > 0) bsp_.set_box_top(build_box_top(bsp_.subtree_boxes(top_slots)));
   }
   std::string name() const override { return bsp_.name(); }
   Hit trace(const Ray& ray, RayCounters* c = nullptr) const override { return bsp_.trace(ray, c); }
@@ -40,7 +43,9 @@ class CertifiedBsp final : public Tracer {
 
 /// Every tracer of one scene; `soup` must outlive it.
 struct ModeSet {
-  std::vector<std::unique_ptr<Tracer>> modes;  ///< kd, bsp, bsp-certified (+ embree when asked)
+  /// kd, bsp, bsp-certified, bsp-top and bsp-top-certified (box tops over
+  /// 8-slot subtrees: many boxes even on small scenes) (+ embree when asked)
+  std::vector<std::unique_ptr<Tracer>> modes;
   std::unique_ptr<Tracer> exact;
 
   ModeSet(const TriangleSoup& soup, bool with_embree, bool with_exact = true) {
@@ -50,6 +55,10 @@ struct ModeSet {
     const FlatBspTree flat = flatten_bsp(soup, build_bsp(soup, config));
     modes.push_back(make_bsp_tracer(soup, flat, BspEpsilon::Certified));
     modes.push_back(std::make_unique<CertifiedBsp>(flat, soup));
+    auto top = std::make_unique<BspTracer>(flat, soup);
+    top->set_box_top(build_box_top(top->subtree_boxes(8)));
+    modes.push_back(std::move(top));
+    modes.push_back(std::make_unique<CertifiedBsp>(flat, soup, 8));
     if (with_embree) modes.push_back(make_tracer("embree", soup));
     if (std::getenv("BSPRT_STIFF_BRUTE")) modes.push_back(make_tracer("brute-certified", soup));
     if (with_exact) exact = make_tracer("exact", soup);

@@ -1,6 +1,6 @@
 // Flat BSP traversal (issue 5): hits equal brute force with no lost hit on
 // shared meshes, stiff generated scenes, translated and scaled scenes and
-// special rays; packets equal single rays bit for bit (hits and counters);
+// special rays, plainly and under box tops (bsp_boxtop.h); packets equal single rays bit for bit (hits and counters);
 // rays from inside closed meshes never escape; the flat sections round-trip.
 #include <catch2/catch.hpp>
 
@@ -12,6 +12,7 @@
 #include <limits>
 #include <chrono>
 #include <cstdlib>
+#include <map>
 #include <random>
 
 #include "bsp_test_util.h"
@@ -78,17 +79,28 @@ std::vector<Ray> all_ray_sets(const TriangleSoup& soup, std::size_t n, std::uint
   return rays;
 }
 
-/// BSP (certified) vs brute force: no lost hit, no farther hit.
+/// `flat` traced plainly (top_slots 0) or under a box top of subtrees of at
+/// most `top_slots` slots.
+BspTracer make_bsp(const FlatBspTree& flat, const TriangleSoup& soup, std::uint32_t top_slots) {
+  BspTracer t(flat, soup);
+  if (top_slots > 0) t.set_box_top(build_box_top(t.subtree_boxes(top_slots)));
+  return t;
+}
+
+/// BSP (certified) vs brute force: no lost hit, no farther hit; plainly and
+/// under box tops of 1-slot (every leaf its own box) and 64-slot subtrees.
 void check_scene(const std::string& name, TriangleSoup soup, std::size_t n = 600) {
   const BspScene s = build_bsp_scene(std::move(soup));
-  const BspTracer tracer(s.flat, s.soup);
   const std::vector<Ray> rays = all_ray_sets(s.soup, n, 7);
-  const Comparison c = compare_with_brute(s.soup, tracer, rays);
-  INFO(name << ": " << c.rays << " rays, " << c.hits << " hits, " << c.ties << " ties, "
-            << c.float_only << " float-only, lost " << c.lost << ", farther " << c.farther
-            << ", impossible " << c.impossible << "; first: " << c.first_failure);
-  CHECK(c.ok());
-  CHECK(c.hits > 0);
+  for (std::uint32_t top : {0u, 1u, 64u}) {
+    const BspTracer tracer = make_bsp(s.flat, s.soup, top);
+    const Comparison c = compare_with_brute(s.soup, tracer, rays);
+    INFO(name << " (box top slots " << top << "): " << c.rays << " rays, " << c.hits << " hits, " << c.ties
+              << " ties, " << c.float_only << " float-only, lost " << c.lost << ", farther " << c.farther
+              << ", impossible " << c.impossible << "; first: " << c.first_failure);
+    CHECK(c.ok());
+    CHECK(c.hits > 0);
+  }
 }
 
 }  // namespace
@@ -232,6 +244,100 @@ TEST_CASE("BSP hits equal brute force on translated and scaled scenes", "[bsp]")
   check_scene("icosphere * 1e-4 + 1e5", transformed(sphere, 1e-4f, {0, 0, 1e5f}));
 }
 
+namespace {
+/// Box of child i of a box-top node.
+Box3f child_box(const BoxTopNode& n, int i) {
+  Box3f b;
+  for (int k = 0; k < 3; ++k) b.lo[k] = n.lo[k][i], b.hi[k] = n.hi[k][i];
+  return b;
+}
+bool contains(const Box3f& outer, const Box3f& inner) {
+  for (int k = 0; k < 3; ++k)
+    if (inner.lo[k] < outer.lo[k] || inner.hi[k] > outer.hi[k]) return false;
+  return true;
+}
+/// Subtree slots under top node `i`, checking that every child box holds the
+/// boxes below it; `box_of` maps a subtree slot to its box.
+void collect(const BoxTop& top, std::uint32_t i, const std::map<std::uint32_t, Box3f>& box_of,
+             std::vector<std::uint32_t>& out, std::size_t& bad_nesting) {
+  const BoxTopNode& n = top.nodes[i];
+  for (int c = 0; c < 4; ++c) {
+    if (n.child[c] == BoxTopNode::kNone) continue;
+    if (n.child[c] & BoxTopNode::kSubtree) {
+      const std::uint32_t slot = n.child[c] & ~BoxTopNode::kSubtree;
+      out.push_back(slot);
+      if (!box_of.count(slot) || !contains(child_box(n, c), box_of.at(slot))) ++bad_nesting;
+      continue;
+    }
+    std::vector<std::uint32_t> below;
+    collect(top, n.child[c], box_of, below, bad_nesting);
+    for (std::uint32_t slot : below)
+      if (!box_of.count(slot) || !contains(child_box(n, c), box_of.at(slot))) ++bad_nesting;
+    out.insert(out.end(), below.begin(), below.end());
+  }
+}
+/// Leaves listing triangles in the compact subtree at slot i.
+void leaves_under(const CompactBspTree& t, std::uint32_t i, std::vector<std::uint32_t>& out) {
+  const CompactBspSlot& n = t.slots[i];
+  if (n.is_leaf()) {
+    if (n.prim_count() > 0) out.push_back(i);
+    return;
+  }
+  if (!n.first_empty()) leaves_under(t, i + n.slots(), out);
+  if (!n.second_empty()) leaves_under(t, n.second_child(), out);
+}
+}  // namespace
+
+TEST_CASE("box top: every leaf under exactly one box and boxes nest", "[bsp]") {
+  const BspScene s = build_bsp_scene(load_mesh(scene_path("suzanne.obj")));
+  const BspTracer plain(s.flat, s.soup);
+  std::vector<std::uint32_t> all_leaves;
+  leaves_under(plain.compact(), 0, all_leaves);
+  REQUIRE(all_leaves.size() > 100);
+  for (std::uint32_t slots : {1u, 8u, 64u, 1024u, CompactBspSlot::kMaxIndex}) {
+    const std::vector<BspSubtreeBox> boxes = plain.subtree_boxes(slots);
+    const BoxTop top = build_box_top(boxes);
+    INFO("slots " << slots << ", " << boxes.size() << " subtrees, " << top.nodes.size() << " top nodes");
+    REQUIRE(!boxes.empty());
+    CHECK(top.subtrees == boxes.size());
+    if (slots == 1) CHECK(boxes.size() == all_leaves.size());  // every leaf its own box
+    if (slots == CompactBspSlot::kMaxIndex) CHECK(boxes.size() == 1);  // the root subtree
+    std::map<std::uint32_t, Box3f> box_of;
+    for (const BspSubtreeBox& b : boxes) box_of[b.slot] = b.box;
+    CHECK(box_of.size() == boxes.size());
+    // The top lists every subtree once, each child box holding the boxes under it.
+    std::vector<std::uint32_t> listed;
+    std::size_t bad_nesting = 0;
+    collect(top, 0, box_of, listed, bad_nesting);
+    CHECK(bad_nesting == 0);
+    std::sort(listed.begin(), listed.end());
+    CHECK(std::adjacent_find(listed.begin(), listed.end()) == listed.end());
+    CHECK(listed.size() == boxes.size());
+    // Every leaf that lists a triangle lies under exactly one subtree.
+    std::vector<std::uint32_t> covered;
+    for (const BspSubtreeBox& b : boxes) leaves_under(plain.compact(), b.slot, covered);
+    std::sort(covered.begin(), covered.end());
+    CHECK(covered == [&] { auto v = all_leaves; std::sort(v.begin(), v.end()); return v; }());
+  }
+}
+
+TEST_CASE("box top: shrunk boxes lose hits and the comparison sees it", "[bsp]") {
+  const BspScene s = build_bsp_scene(load_mesh(scene_path("suzanne.obj")));
+  BspTracer tracer(s.flat, s.soup);
+  std::vector<BspSubtreeBox> boxes = tracer.subtree_boxes(64);
+  for (BspSubtreeBox& b : boxes) {  // a tenth off each side: triangles near box faces fall out
+    const Vec3f d = b.box.diagonal() * 0.1f;
+    b.box.lo += d;
+    b.box.hi -= d;
+  }
+  tracer.set_box_top(build_box_top(boxes));
+  CHECK(tracer.name() == "bsp-top");
+  const Comparison c = compare_with_brute(s.soup, tracer, all_ray_sets(s.soup, 300, 7));
+  INFO("lost " << c.lost << ", farther " << c.farther << " of " << c.hits);
+  CHECK(c.lost + c.farther > 0);
+  CHECK_FALSE(c.ok());
+}
+
 TEST_CASE("BSP packets equal single rays exactly", "[bsp]") {
   const BspScene s = build_bsp_scene(load_mesh(scene_path("suzanne.obj")));
   const BspScene q = build_bsp_scene(make_default_scene());
@@ -281,19 +387,21 @@ TEST_CASE("BSP rays from inside closed meshes never escape", "[bsp]") {
   for (const auto& [scale, shift] : {std::pair{1.0f, Vec3f{0, 0, 0}}, std::pair{1e-4f, Vec3f{0, 0, 0}},
                                      std::pair{1.0f, Vec3f{1e4f, -1e4f, 0}}}) {
     const BspScene s = build_bsp_scene(transformed(make_icosphere({0, 0, 0}, 1.0f, 3), scale, shift));
-    const BspTracer tracer(s.flat, s.soup);
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-    std::size_t escaped = 0;
-    for (int i = 0; i < 4000; ++i) {
-      Vec3f p{u(rng), u(rng), u(rng)}, d{u(rng), u(rng), u(rng)};
-      if (length(p) > 0.9f || length(d) < 1e-3f) continue;
-      if (i % 4 == 0) d = {0, 0, d.z < 0 ? -1.0f : 1.0f};          // axis-aligned
-      if (i % 4 == 1) d = {d.x, 0, d.z};                            // a zero component
-      escaped += !tracer.trace(Ray{p * scale + shift, 0, d}).hit();
+    for (std::uint32_t top : {0u, 1u, 64u}) {
+      const BspTracer tracer = make_bsp(s.flat, s.soup, top);
+      std::mt19937 rng(5);
+      std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+      std::size_t escaped = 0;
+      for (int i = 0; i < 4000; ++i) {
+        Vec3f p{u(rng), u(rng), u(rng)}, d{u(rng), u(rng), u(rng)};
+        if (length(p) > 0.9f || length(d) < 1e-3f) continue;
+        if (i % 4 == 0) d = {0, 0, d.z < 0 ? -1.0f : 1.0f};          // axis-aligned
+        if (i % 4 == 1) d = {d.x, 0, d.z};                            // a zero component
+        escaped += !tracer.trace(Ray{p * scale + shift, 0, d}).hit();
+      }
+      INFO("scale " << scale << ", box top slots " << top);
+      CHECK(escaped == 0);
     }
-    INFO("scale " << scale);
-    CHECK(escaped == 0);
   }
 }
 
@@ -332,17 +440,20 @@ std::vector<Ray> special_rays(const TriangleSoup& soup) {
 TEST_CASE("BSP special rays equal brute force", "[bsp]") {
   for (const char* name : {"cube.obj", "suzanne.obj", "stiff_cube_with_fold.ply", "stiff_planexy.off"}) {
     const BspScene s = build_bsp_scene(load_mesh(scene_path(name)));
-    const BspTracer tracer(s.flat, s.soup);
     const std::vector<Ray> rays = special_rays(s.soup);
-    const Comparison c = compare_with_brute(s.soup, tracer, rays);
-    INFO(name << ": " << c.rays << " rays, lost " << c.lost << ", farther " << c.farther
-              << ", impossible " << c.impossible << "; first: " << c.first_failure);
-    CHECK(c.ok());
+    for (std::uint32_t top : {0u, 1u, 64u}) {
+      const Comparison c = compare_with_brute(s.soup, make_bsp(s.flat, s.soup, top), rays);
+      INFO(name << " (box top slots " << top << "): " << c.rays << " rays, lost " << c.lost << ", farther "
+                << c.farther << ", impossible " << c.impossible << "; first: " << c.first_failure);
+      CHECK(c.ok());
+    }
   }
   const BspScene g = build_bsp_scene(make_default_scene());
-  const Comparison c = compare_with_brute(g.soup, BspTracer(g.flat, g.soup), special_rays(g.soup));
-  INFO("default scene: first: " << c.first_failure);
-  CHECK(c.ok());
+  for (std::uint32_t top : {0u, 1u, 64u}) {
+    const Comparison c = compare_with_brute(g.soup, make_bsp(g.flat, g.soup, top), special_rays(g.soup));
+    INFO("default scene (box top slots " << top << "): first: " << c.first_failure);
+    CHECK(c.ok());
+  }
 }
 
 TEST_CASE("BSP flat sections round-trip through a tree file", "[bsp]") {

@@ -141,6 +141,21 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
   CHECK(compare_hits(brute, kd_hits).agrees());
   CHECK(bsprt_cli("compare " + temp_path("cli_suzanne_exact.hits") + " " + temp_path("cli_suzanne_bsp-certified.hits")).status == 0);
 
+  // Under a box top of small subtrees (many boxes), the same guarantees, and
+  // --stats counts the box nodes.
+  const HitComparison ct = compare_hits(exact, trace("bsp-top-certified", "--tree " + tree + " --top-slots 4"));
+  CHECK(ct.agrees());
+  CHECK(ct.tie == 0);
+  CHECK(ct.max_t_ulps == 0);
+  CHECK(compare_hits(brute, trace("bsp-top", "--tree " + tree + " --top-slots 4")).agrees());
+  const Run ts = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp-top --tree " +
+                           tree + " --stats");
+  INFO(ts.output);
+  CHECK(ts.status == 0);
+  CHECK(ts.output.find("box-top node visits") != std::string::npos);
+  CHECK(bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp-top --top-slots 0")
+            .status == 2);
+
   // A tree is bound to its scene and kind.
   const Run wrong = bsprt_cli("trace " + scene_path("cube.obj") + " " + rays + " -o " + temp_path("x.hits") +
                               " --accel bsp --tree " + tree);

@@ -3,11 +3,16 @@
 /// with -ffp-contract=off: bsp_packet.inl repeats these steps bit for bit.
 #include "traverse/bsp_traverse.h"
 
+#include <bit>
+#include <utility>
+#include <cstddef>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
 #include "geometry/error.h"
 #include "traverse/bsp_kernel.h"
+#include "traverse/simd.h"
 #include "traverse/cpu_features.h"
 #include "traverse/watertight.h"
 
@@ -16,6 +21,9 @@ namespace {
 
 using detail::BspRayConst;
 using detail::BspView;
+
+/// Entries of the box top's stack: three per level of Embree's maxDepth (64).
+constexpr int kTopStackSize = 3 * 64 + 4;
 
 /// A far child waiting on the stack with the ray's (conservative) interval.
 struct StackEntry {
@@ -60,22 +68,18 @@ inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near
 }
 
 /// Front-to-back traversal (pbrt's kd-tree loop with the paper's BSP node
-/// step, made conservative). A child is culled when its conservative interval
-/// is empty (NaN crossings cull nothing) or when it lists no triangle (not
-/// stored, bsp_compact.h); a popped cell is skipped when it starts past the
-/// nearest hit. bsp_packet.inl repeats these steps.
+/// step, made conservative) of the subtree at slot `root`, entered with the
+/// ray interval [tmin, tmax]. A child is culled when its conservative
+/// interval is empty (NaN crossings cull nothing) or when it lists no
+/// triangle (not stored, bsp_compact.h); a popped cell is skipped when it
+/// starts past the nearest hit. bsp_packet.inl repeats these steps.
 template <bool kCount>
-Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
-  Hit hit;
-  if constexpr (kCount) ++c->rays;
-  const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
-  if (!rc.live) return hit;
-  const WatertightRay wr = watertight_precompute(ray);
-  NearestHit nearest;
-  float tmin = rc.tmin, tmax = rc.tmax;
+inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray& ray, const WatertightRay& wr,
+                             std::uint32_t root, float tmin, float tmax, Hit& hit, NearestHit& nearest,
+                             RayCounters* c) {
   StackEntry stack[kBspMaxDepth];
   int sp = 0;
-  std::uint32_t node = 0;
+  std::uint32_t node = root;
   for (;;) {
     const CompactBspSlot* n = &v.nodes[node];
     bool leaf = true;
@@ -110,13 +114,122 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
     }
     if (leaf) intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
     for (;;) {
-      if (sp == 0) return hit;
+      if (sp == 0) return;
       const StackEntry& e = stack[--sp];
       if (e.tmin > hit.t) continue;
       node = e.node;
       tmin = e.tmin;
       tmax = e.tmax < hit.t ? e.tmax : hit.t;
       break;
+    }
+  }
+}
+
+/// One ray through the whole tree.
+template <bool kCount>
+Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
+  Hit hit;
+  if constexpr (kCount) ++c->rays;
+  const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
+  if (!rc.live) return hit;
+  const WatertightRay wr = watertight_precompute(ray);
+  NearestHit nearest;
+  traverse_subtree<kCount>(v, rc, ray, wr, 0, rc.tmin, rc.tmax, hit, nearest, c);
+  return hit;
+}
+
+/// One ray through the box top (bsp_boxtop.h), then the BSP subtrees whose
+/// boxes it enters, nearest box first. A box is entered with the ray's
+/// interval clipped to it by widened slab crossings (monotone, so widening
+/// the max/min equals widening each crossing as bsp_ray_setup does); a
+/// subtree then runs the certified steps from its root.
+template <bool kCount>
+Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCounters* c) {
+  using V = simd::vfloat<4>;
+  Hit hit;
+  if constexpr (kCount) ++c->rays;
+  const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
+  if (!rc.live) return hit;
+  const WatertightRay wr = watertight_precompute(ray);
+  NearestHit nearest;
+  struct Entry {
+    std::uint32_t ref;
+    float tmin, tmax;
+  };
+  Entry stack[kTopStackSize];
+  int sp = 0;
+  Entry cur{0, rc.tmin, rc.tmax};
+  // Offsets (in floats) of the entry and exit planes of axis k in a node:
+  // lo[k] is at 4k, hi[k] at 12 + 4k; a negative direction swaps them.
+  int near_off[3], far_off[3];
+  for (int k = 0; k < 3; ++k) {
+    near_off[k] = 4 * k + (rc.neg[k] ? 12 : 0);
+    far_off[k] = 4 * k + (rc.neg[k] ? 0 : 12);
+  }
+  static_assert(offsetof(BoxTopNode, hi) == 12 * sizeof(float));
+  const float inf = std::numeric_limits<float>::infinity();
+  for (;;) {
+    if ((cur.ref & BoxTopNode::kSubtree) != 0) {
+      traverse_subtree<kCount>(v, rc, ray, wr, cur.ref & ~BoxTopNode::kSubtree, cur.tmin,
+                               cur.tmax < hit.t ? cur.tmax : hit.t, hit, nearest, c);
+    } else {
+      const BoxTopNode& n = nodes[cur.ref];
+      if constexpr (kCount) ++c->box_node_visits;
+      V enter = simd::splat<4>(-inf), exit = simd::splat<4>(inf);
+      const float* box = &n.lo[0][0];
+      for (int k = 0; k < 3; ++k) {
+        const V e = (simd::load<4>(box + near_off[k]) - rc.o[k]) * rc.inv[k];
+        const V x = (simd::load<4>(box + far_off[k]) - rc.o[k]) * rc.inv[k];
+        enter = e > enter ? e : enter;  // NaN crossings do not clip
+        exit = x < exit ? x : exit;
+      }
+      const float hi = cur.tmax < hit.t ? cur.tmax : hit.t;
+      enter = detail::widen_dn(enter);
+      exit = detail::widen_up(exit);
+      enter = enter > cur.tmin ? enter : simd::splat<4>(cur.tmin);
+      exit = exit < hi ? exit : simd::splat<4>(hi);
+      const auto live = (enter <= exit) &
+                        (simd::load_int<4>(reinterpret_cast<const std::int32_t*>(n.child)) != -1);
+      unsigned bits = simd::movemask<4>(live);
+      if (bits != 0) {
+        alignas(16) float lo[4], up[4];
+        simd::store<4>(lo, enter);
+        simd::store<4>(up, exit);
+        const int i0 = std::countr_zero(bits);
+        bits &= bits - 1;
+        Entry a{n.child[i0], lo[i0], up[i0]};
+        if (bits == 0) {  // one box: the common case, no ordering
+          cur = a;
+          continue;
+        }
+        const int i1 = std::countr_zero(bits);
+        bits &= bits - 1;
+        Entry b{n.child[i1], lo[i1], up[i1]};
+        if (b.tmin < a.tmin) std::swap(a, b);
+        if (bits == 0) {
+          stack[sp++] = b;
+          cur = a;
+          continue;
+        }
+        Entry hits[4] = {a, b};  // three or four boxes: insertion sort, nearest first
+        int count = 2;
+        while (bits != 0) {
+          const int i = std::countr_zero(bits);
+          bits &= bits - 1;
+          const Entry e{n.child[i], lo[i], up[i]};
+          int j = count++;
+          for (; j > 0 && hits[j - 1].tmin > e.tmin; --j) hits[j] = hits[j - 1];
+          hits[j] = e;
+        }
+        for (int j = count - 1; j > 0; --j) stack[sp++] = hits[j];
+        cur = hits[0];
+        continue;
+      }
+    }
+    for (;;) {
+      if (sp == 0) return hit;
+      cur = stack[--sp];
+      if (!(cur.tmin > hit.t)) break;
     }
   }
 }
@@ -164,6 +277,14 @@ Hit BspTracer::trace(const Ray& ray, RayCounters* counters) const {
     if (counters) ++counters->rays;
     return Hit{};
   }
+  if (has_top_) {
+    if (top_.nodes.empty()) {
+      if (counters) ++counters->rays;
+      return Hit{};
+    }
+    return counters ? trace_top<true>(v, top_.nodes.data(), ray, counters)
+                    : trace_top<false>(v, top_.nodes.data(), ray, nullptr);
+  }
   return counters ? trace_single<true>(v, ray, counters) : trace_single<false>(v, ray, nullptr);
 }
 
@@ -176,7 +297,7 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   if (int(detected_isa()) < int(need))
     throw UsageError("packets of " + std::to_string(packet_width) + " rays need " +
                      isa_name(need) + ", this CPU has " + isa_name(detected_isa()));
-  if (need == Isa::Scalar || tree_.bounds.empty() || exact_leaf_) {  // exact leaves: single rays
+  if (need == Isa::Scalar || tree_.bounds.empty() || exact_leaf_ || has_top_) {  // exact leaves, box top: single rays
     for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
     return;
   }
@@ -195,8 +316,17 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   }
 }
 
+std::vector<BspSubtreeBox> BspTracer::subtree_boxes(std::uint32_t max_slots) const {
+  return bsp_subtree_boxes(compact_, triangles_, tree_.bounds, max_slots);
+}
+
+void BspTracer::set_box_top(BoxTop top) {
+  top_ = std::move(top);
+  has_top_ = true;
+}
+
 std::size_t BspTracer::memory_bytes() const {
-  return compact_.slots.size() * sizeof(CompactBspSlot) + tree_.prims.size() * sizeof(std::uint32_t) +
+  return top_.nodes.size() * sizeof(BoxTopNode) + compact_.slots.size() * sizeof(CompactBspSlot) + tree_.prims.size() * sizeof(std::uint32_t) +
          triangles_.size() * sizeof(BspTriangle);
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "geometry/triangle_soup.h"
+#include "traverse/bsp_boxtop.h"
 #include "traverse/bsp_compact.h"
 #include "traverse/bsp_node.h"
 #include "traverse/leaf_intersector.h"
@@ -42,8 +43,10 @@ class BspTracer final : public Tracer {
   /// was built for a scene with another triangle count.
   BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode = BspEpsilon::Certified);
 
+  /// bsp, bsp-certified, bsp-zero-eps; with a box top bsp-top, bsp-top-certified, bsp-top-zero-eps.
   std::string name() const override {
-    return exact_leaf_ ? "bsp-certified" : (mode_ == BspEpsilon::Zero ? "bsp-zero-eps" : "bsp");
+    const std::string base = exact_leaf_ ? "bsp-certified" : (mode_ == BspEpsilon::Zero ? "bsp-zero-eps" : "bsp");
+    return has_top_ ? "bsp-top" + base.substr(3) : base;
   }
   /// Tests leaves with `exact` (exact decisions, robust/certified_intersector.h)
   /// instead of the float watertight test; it must outlive the tracer. With
@@ -59,7 +62,15 @@ class BspTracer final : public Tracer {
   /// stack), so hits and counters equal single rays bit for bit.
   void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width = 1,
                    RayCounters* counters = nullptr) const override;
-  /// Nodes, leaf lists and the copied triangles.
+  /// The tree cut into subtrees of at most `max_slots` slots, with their
+  /// certified boxes (bsp_boxtop.h), to build a box top from.
+  std::vector<BspSubtreeBox> subtree_boxes(std::uint32_t max_slots) const;
+  /// Traces single rays through `top` (built from subtree_boxes()) before the
+  /// BSP subtrees; packets then run as single rays.
+  void set_box_top(BoxTop top);
+  bool has_box_top() const { return has_top_; }
+  const BoxTop& box_top() const { return top_; }
+  /// Nodes, leaf lists, the copied triangles and the box top.
   std::size_t memory_bytes() const override;
 
   BspEpsilon mode() const { return mode_; }
@@ -72,6 +83,8 @@ class BspTracer final : public Tracer {
   BspEpsilon mode_;
   const LeafIntersector* exact_leaf_ = nullptr;
   std::vector<BspTriangle> triangles_;  ///< triangles_[i] = corners of tree_.prims[i]
+  BoxTop top_;
+  bool has_top_ = false;
 };
 
 }  // namespace bsprt

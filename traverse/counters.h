@@ -15,6 +15,7 @@ struct RayCounters {
   std::uint64_t bsp_node_visits = 0;  ///< inner nodes with a general plane
   std::uint64_t leaf_visits = 0;      ///< leaves entered
   std::uint64_t triangle_tests = 0;   ///< ray/triangle tests run
+  std::uint64_t box_node_visits = 0;  ///< 4-wide box nodes of a box top (bsp_boxtop.h)
 
   RayCounters& operator+=(const RayCounters& o) {
     rays += o.rays;
@@ -22,6 +23,7 @@ struct RayCounters {
     bsp_node_visits += o.bsp_node_visits;
     leaf_visits += o.leaf_visits;
     triangle_tests += o.triangle_tests;
+    box_node_visits += o.box_node_visits;
     return *this;
   }
 };
