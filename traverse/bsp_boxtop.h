@@ -6,7 +6,7 @@
 /// in one vector step (Embree's strength), and the BSP below keeps its cells
 /// (its strength: few triangle tests).
 ///
-/// Certificate (docs/certified-epsilons.md §8): the box of a subtree is the
+/// Certificate (docs/certified-epsilons.md §10): the box of a subtree is the
 /// union, over its leaves, of the box of the leaf's triangles intersected with
 /// the box that the kd splits above the leaf cut out of the root cell. Every
 /// one of these numbers is a float of the scene or of the tree, and min/max are
