@@ -4,6 +4,7 @@
 /// and the result is copied into BoxTopNodes in depth-first order.
 #include <embree3/rtcore.h>
 
+#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -11,6 +12,11 @@
 
 namespace bsprt {
 namespace {
+
+/// Embree's rtcBuildBVH stops splitting at maxDepth and makes a leaf of
+/// several subtrees, which create_leaf refuses (maxLeafSize 1), so the top is
+/// at most kMaxDepth deep and trace_top's stack of 3·64 + 4 entries suffices.
+constexpr unsigned kMaxDepth = 64;
 
 /// Embree-allocated build node: inner (children) or leaf (a subtree).
 struct BuildNode {
@@ -60,19 +66,21 @@ struct Flattener {
   /// Child reference of b, its box in `box`; inner nodes are appended depth
   /// first. The boxes are recomputed from the subtree boxes (exact min/max),
   /// not taken from the builder, so the certificate does not rest on Embree.
-  std::uint32_t add(const BuildNode* b, Box3f& box) {
+  std::uint32_t add(const BuildNode* b, Box3f& box, unsigned depth = 1) {
     if (b == nullptr) throw std::runtime_error("embree: rtcBuildBVH returned an incomplete tree");
     if (b->leaf) {
       box = subtrees[b->subtree].box;
       return BoxTopNode::kSubtree | subtrees[b->subtree].slot;
     }
+    if (depth > kMaxDepth) throw std::runtime_error("embree: rtcBuildBVH exceeded the depth limit");
+    if (b->count > 4) throw std::runtime_error("embree: rtcBuildBVH made a node of more than 4 children");
     const auto index = std::uint32_t(top.nodes.size());
     top.nodes.emplace_back();
     BoxTopNode n = empty_node();
     box = Box3f{};
     for (unsigned i = 0; i < b->count; ++i) {
       Box3f c;
-      n.child[i] = add(b->child[i], c);
+      n.child[i] = add(b->child[i], c, depth + 1);
       set_child_box(n, int(i), c);
       box.extend(c);
     }
@@ -105,7 +113,7 @@ BoxTop build_box_top(std::span<const BspSubtreeBox> subtrees) {
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
   args.maxBranchingFactor = 4;
-  args.maxDepth = 64;
+  args.maxDepth = kMaxDepth;
   args.minLeafSize = 1;
   args.maxLeafSize = 1;
   args.traversalCost = 1.0f;

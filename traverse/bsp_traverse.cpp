@@ -4,16 +4,16 @@
 #include "traverse/bsp_traverse.h"
 
 #include <bit>
-#include <utility>
 #include <cstddef>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "geometry/error.h"
 #include "traverse/bsp_kernel.h"
-#include "traverse/simd.h"
 #include "traverse/cpu_features.h"
+#include "traverse/simd.h"
 #include "traverse/watertight.h"
 
 namespace bsprt {
@@ -297,7 +297,8 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   if (int(detected_isa()) < int(need))
     throw UsageError("packets of " + std::to_string(packet_width) + " rays need " +
                      isa_name(need) + ", this CPU has " + isa_name(detected_isa()));
-  if (need == Isa::Scalar || tree_.bounds.empty() || exact_leaf_ || has_top_) {  // exact leaves, box top: single rays
+  // Exact leaves and box tops trace single rays.
+  if (need == Isa::Scalar || tree_.bounds.empty() || exact_leaf_ || has_top_) {
     for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
     return;
   }
@@ -326,8 +327,8 @@ void BspTracer::set_box_top(BoxTop top) {
 }
 
 std::size_t BspTracer::memory_bytes() const {
-  return top_.nodes.size() * sizeof(BoxTopNode) + compact_.slots.size() * sizeof(CompactBspSlot) + tree_.prims.size() * sizeof(std::uint32_t) +
-         triangles_.size() * sizeof(BspTriangle);
+  return top_.nodes.size() * sizeof(BoxTopNode) + compact_.slots.size() * sizeof(CompactBspSlot) +
+         tree_.prims.size() * sizeof(std::uint32_t) + triangles_.size() * sizeof(BspTriangle);
 }
 
 }  // namespace bsprt
