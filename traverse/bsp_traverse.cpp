@@ -125,33 +125,38 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
   }
 }
 
-/// One ray through the whole tree.
-template <bool kCount>
-Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
+/// One ray: counts it, makes its constants, and unless it is invalid or
+/// misses the root box hands them to walk(rc, wr, hit, nearest).
+template <bool kCount, typename Walk>
+inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& walk) {
   Hit hit;
   if constexpr (kCount) ++c->rays;
   const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
   if (!rc.live) return hit;
   const WatertightRay wr = watertight_precompute(ray);
   NearestHit nearest;
-  traverse_subtree<kCount>(v, rc, ray, wr, 0, rc.tmin, rc.tmax, hit, nearest, c);
+  walk(rc, wr, hit, nearest);
   return hit;
 }
 
-/// One ray through the box top (bsp_boxtop.h), then the BSP subtrees whose
-/// boxes it enters, nearest box first. A box is entered with the ray's
-/// interval clipped to it by widened slab crossings (monotone, so widening
-/// the max/min equals widening each crossing as bsp_ray_setup does); a
-/// subtree then runs the certified steps from its root.
+/// One ray through the whole tree.
 template <bool kCount>
-Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCounters* c) {
+Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
+  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const WatertightRay& wr, Hit& hit,
+                                          NearestHit& nearest) {
+    traverse_subtree<kCount>(v, rc, ray, wr, 0, rc.tmin, rc.tmax, hit, nearest, c);
+  });
+}
+
+/// The box top (bsp_boxtop.h), then the BSP subtrees whose boxes the ray
+/// enters, nearest box first. A box is entered with the ray's interval
+/// clipped to it by widened slab crossings (monotone, so widening the max/min
+/// equals widening each crossing as bsp_ray_setup does); a subtree then runs
+/// the certified steps from its root.
+template <bool kCount>
+inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayConst& rc, const Ray& ray,
+                     const WatertightRay& wr, Hit& hit, NearestHit& nearest, RayCounters* c) {
   using V = simd::vfloat<4>;
-  Hit hit;
-  if constexpr (kCount) ++c->rays;
-  const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
-  if (!rc.live) return hit;
-  const WatertightRay wr = watertight_precompute(ray);
-  NearestHit nearest;
   struct Entry {
     std::uint32_t ref;
     float tmin, tmax;
@@ -227,11 +232,20 @@ Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCoun
       }
     }
     for (;;) {
-      if (sp == 0) return hit;
+      if (sp == 0) return;
       cur = stack[--sp];
       if (!(cur.tmin > hit.t)) break;
     }
   }
+}
+
+/// One ray through the box top and the subtrees under it.
+template <bool kCount>
+Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCounters* c) {
+  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const WatertightRay& wr, Hit& hit,
+                                          NearestHit& nearest) {
+    walk_top<kCount>(v, nodes, rc, ray, wr, hit, nearest, c);
+  });
 }
 
 /// Depth of the deepest leaf.
