@@ -59,6 +59,21 @@ void set_child_box(BoxTopNode& n, int i, const Box3f& b) {
   for (int k = 0; k < 3; ++k) n.lo[k][i] = b.lo[k], n.hi[k][i] = b.hi[k];
 }
 
+/// One Embree device for every box-top build of the process: making a device
+/// starts Embree's worker threads, which would dominate the build of a small
+/// scene's top. BVHs of one device may be built from several threads.
+RTCDevice shared_device() {
+  struct Holder {
+    RTCDevice device = rtcNewDevice(nullptr);
+    ~Holder() {
+      if (device) rtcReleaseDevice(device);
+    }
+  };
+  static const Holder holder;
+  if (!holder.device) throw std::runtime_error("embree: rtcNewDevice failed");
+  return holder.device;
+}
+
 struct Flattener {
   std::span<const BspSubtreeBox> subtrees;
   BoxTop top;
@@ -107,8 +122,7 @@ BoxTop build_box_top(std::span<const BspSubtreeBox> subtrees) {
     const Box3f& b = subtrees[i].box;
     prims[i] = {b.lo.x, b.lo.y, b.lo.z, 0u, b.hi.x, b.hi.y, b.hi.z, std::uint32_t(i)};
   }
-  RTCDevice device = rtcNewDevice(nullptr);
-  if (!device) throw std::runtime_error("embree: rtcNewDevice failed");
+  const RTCDevice device = shared_device();
   RTCBVH bvh = rtcNewBVH(device);
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
@@ -133,14 +147,18 @@ BoxTop build_box_top(std::span<const BspSubtreeBox> subtrees) {
     if (err != RTC_ERROR_NONE || root == nullptr)
       throw std::runtime_error("embree: rtcBuildBVH failed (code " + std::to_string(int(err)) + ")");
     Box3f all;
-    f.add(root, all);
+    const std::uint32_t ref = f.add(root, all);
+    if (ref & BoxTopNode::kSubtree) {  // a bare leaf at the root (not expected with >= 2 subtrees)
+      BoxTopNode n = empty_node();
+      set_child_box(n, 0, all);
+      n.child[0] = ref;
+      f.top.nodes.push_back(n);
+    }
   } catch (...) {
     rtcReleaseBVH(bvh);
-    rtcReleaseDevice(device);
     throw;
   }
   rtcReleaseBVH(bvh);
-  rtcReleaseDevice(device);
   f.top.subtrees = top.subtrees;
   return std::move(f.top);
 }
