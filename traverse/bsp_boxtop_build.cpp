@@ -4,6 +4,7 @@
 /// and the result is copied into BoxTopNodes in depth-first order.
 #include <embree3/rtcore.h>
 
+#include <mutex>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -61,7 +62,8 @@ void set_child_box(BoxTopNode& n, int i, const Box3f& b) {
 
 /// One Embree device for every box-top build of the process: making a device
 /// starts Embree's worker threads, which would dominate the build of a small
-/// scene's top. BVHs of one device may be built from several threads.
+/// scene's top. Builds on it are serialized (build_box_top's lock): Embree
+/// promises thread safety only for calls on different objects.
 RTCDevice shared_device() {
   struct Holder {
     RTCDevice device = rtcNewDevice(nullptr);
@@ -122,6 +124,8 @@ BoxTop build_box_top(std::span<const BspSubtreeBox> subtrees) {
     const Box3f& b = subtrees[i].box;
     prims[i] = {b.lo.x, b.lo.y, b.lo.z, 0u, b.hi.x, b.hi.y, b.hi.z, std::uint32_t(i)};
   }
+  static std::mutex build_lock;  // rare (one build per tracer); Embree parallelizes each build itself
+  const std::lock_guard<std::mutex> lock(build_lock);
   const RTCDevice device = shared_device();
   RTCBVH bvh = rtcNewBVH(device);
   RTCBuildArguments args = rtcDefaultBuildArguments();
