@@ -44,7 +44,7 @@ class CertifiedBspTracer final : public Tracer {
   CertifiedBspTracer(FlatBspTree flat, const TriangleSoup& soup, std::uint32_t top_slots = 0)
       : exact_(soup), bsp_(std::move(flat), soup, BspEpsilon::Certified) {
     bsp_.set_exact_leaf(&exact_);
-    if (top_slots > 0) bsp_.set_box_top(build_box_top(bsp_.subtree_boxes(top_slots)));
+    if (top_slots > 0) add_box_top(bsp_, top_slots);
   }
   std::string name() const override { return bsp_.name(); }
   Hit trace(const Ray& ray, RayCounters* counters) const override { return bsp_.trace(ray, counters); }
@@ -101,7 +101,7 @@ std::unique_ptr<Tracer> make_tracer(const std::string& accel, const TriangleSoup
   if (accel == "bsp-zero-eps") return make_bsp_tracer(soup, load_or_build_bsp(soup, options), BspEpsilon::Zero);
   if (accel == "bsp-top") {
     auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(soup, options), soup, BspEpsilon::Certified);
-    bsp->set_box_top(build_box_top(bsp->subtree_boxes(options.top_slots)));
+    add_box_top(*bsp, options.top_slots);
     return bsp;
   }
   if (accel == "bsp-top-certified")

@@ -31,7 +31,7 @@ class CertifiedBsp final : public Tracer {
   CertifiedBsp(FlatBspTree flat, const TriangleSoup& soup, std::uint32_t top_slots = 0)
       : exact_(soup), bsp_(std::move(flat), soup) {
     bsp_.set_exact_leaf(&exact_);
-    if (top_slots > 0) bsp_.set_box_top(build_box_top(bsp_.subtree_boxes(top_slots)));
+    if (top_slots > 0) add_box_top(bsp_, top_slots);
   }
   std::string name() const override { return bsp_.name(); }
   Hit trace(const Ray& ray, RayCounters* c = nullptr) const override { return bsp_.trace(ray, c); }
@@ -56,7 +56,7 @@ struct ModeSet {
     modes.push_back(make_bsp_tracer(soup, flat, BspEpsilon::Certified));
     modes.push_back(std::make_unique<CertifiedBsp>(flat, soup));
     auto top = std::make_unique<BspTracer>(flat, soup);
-    top->set_box_top(build_box_top(top->subtree_boxes(8)));
+    add_box_top(*top, 8);
     modes.push_back(std::move(top));
     modes.push_back(std::make_unique<CertifiedBsp>(flat, soup, 8));
     if (with_embree) modes.push_back(make_tracer("embree", soup));

@@ -83,7 +83,7 @@ std::vector<Ray> all_ray_sets(const TriangleSoup& soup, std::size_t n, std::uint
 /// most `top_slots` slots.
 BspTracer make_bsp(const FlatBspTree& flat, const TriangleSoup& soup, std::uint32_t top_slots) {
   BspTracer t(flat, soup);
-  if (top_slots > 0) t.set_box_top(build_box_top(t.subtree_boxes(top_slots)));
+  if (top_slots > 0) add_box_top(t, top_slots);
   return t;
 }
 

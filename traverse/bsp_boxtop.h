@@ -26,6 +26,8 @@
 
 namespace bsprt {
 
+class BspTracer;
+
 /// One node of the box top: four children, boxes in SoA order.
 struct alignas(16) BoxTopNode {
   float lo[3][4];              ///< lo[axis][child]
@@ -61,5 +63,10 @@ std::vector<BspSubtreeBox> bsp_subtree_boxes(const CompactBspTree& tree, std::sp
 /// rtcBuildBVH); each leaf holds one subtree. Defined in bsp_boxtop_build.cpp
 /// (library bsprt::embree).
 BoxTop build_box_top(std::span<const BspSubtreeBox> subtrees);
+
+/// Puts `tracer` under a box top of subtrees of at most `max_slots` slots:
+/// tracer.set_box_top(build_box_top(tracer.subtree_boxes(max_slots))).
+/// Defined in bsp_boxtop_build.cpp (library bsprt::embree).
+void add_box_top(BspTracer& tracer, std::uint32_t max_slots);
 
 }  // namespace bsprt

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "traverse/bsp_boxtop.h"
+#include "traverse/bsp_traverse.h"
 
 namespace bsprt {
 namespace {
@@ -165,6 +166,10 @@ BoxTop build_box_top(std::span<const BspSubtreeBox> subtrees) {
   rtcReleaseBVH(bvh);
   f.top.subtrees = top.subtrees;
   return std::move(f.top);
+}
+
+void add_box_top(BspTracer& tracer, std::uint32_t max_slots) {
+  tracer.set_box_top(build_box_top(tracer.subtree_boxes(max_slots)));
 }
 
 }  // namespace bsprt
