@@ -26,6 +26,11 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
                  "bsp-top: largest BSP subtree (8-byte slots) under one box of the box top")
       ->check(CLI::Range(1u, 1u << 27))
       ->capture_default_str();
+  cmd.add_option("--single-rays", o.single_rays,
+                 "bsp, bsp-zero-eps: how single rays run: auto (interleaved unless the rays look like camera "
+                 "rays), sequential or interleaved; the hits are the same")
+      ->check(CLI::IsMember({"auto", "sequential", "interleaved"}))
+      ->capture_default_str();
   cmd.add_flag("--allow-nonfinite", o.allow_nonfinite,
                "keep triangles with NaN/Inf corners (flagged degenerate, never hit) instead of failing");
 }
@@ -70,6 +75,9 @@ std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& so
   options.threads = o.threads;
   options.bsp.membership = parse_membership(o.membership);
   options.top_slots = o.top_slots;
+  options.single_rays = o.single_rays == "sequential"    ? BspSingleRays::Sequential
+                        : o.single_rays == "interleaved" ? BspSingleRays::Interleaved
+                                                         : BspSingleRays::Auto;
   const bool building = o.tree.empty() && (o.accel == "kd" || o.accel.rfind("bsp", 0) == 0);
   std::unique_ptr<ProgressBar> bar;
   if (building && ProgressBar::stderr_is_terminal()) {

@@ -24,10 +24,11 @@ struct TraceOptions {
   bool allow_nonfinite = false;
   std::string membership = "area";
   std::uint32_t top_slots = 1024;
+  std::string single_rays = "auto";
 };
 
 /// Adds --accel, --tree, --threads, --packets, --membership, --top-slots,
-/// --allow-nonfinite to `cmd`.
+/// --single-rays, --allow-nonfinite to `cmd`.
 void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& default_accel);
 
 /// Loads SCENE, or the embedded default scene when `path` is empty or

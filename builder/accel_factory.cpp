@@ -97,8 +97,12 @@ std::unique_ptr<Tracer> make_tracer(const std::string& accel, const TriangleSoup
     return std::make_unique<EmbreeTracer>(soup, c);
   }
   if (accel == "kd") return make_kd(soup, options);
-  if (accel == "bsp") return make_bsp_tracer(soup, load_or_build_bsp(soup, options), BspEpsilon::Certified);
-  if (accel == "bsp-zero-eps") return make_bsp_tracer(soup, load_or_build_bsp(soup, options), BspEpsilon::Zero);
+  if (accel == "bsp" || accel == "bsp-zero-eps") {
+    auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(soup, options), soup,
+                                           accel == "bsp" ? BspEpsilon::Certified : BspEpsilon::Zero);
+    bsp->set_single_rays(options.single_rays);
+    return bsp;
+  }
   if (accel == "bsp-top") {
     auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(soup, options), soup, BspEpsilon::Certified);
     add_box_top(*bsp, options.top_slots);

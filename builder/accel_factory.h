@@ -12,6 +12,7 @@
 #include "builder/bsp_config.h"
 
 #include "geometry/triangle_soup.h"
+#include "traverse/bsp_traverse.h"
 #include "traverse/tracer.h"
 
 namespace bsprt {
@@ -26,6 +27,8 @@ struct AccelOptions {
   /// bsp-top, bsp-top-certified: largest BSP subtree (in 8-byte slots) under
   /// one box of the box top (traverse/bsp_boxtop.h).
   std::uint32_t top_slots = 1024;
+  /// bsp, bsp-zero-eps: how batches of single rays run (traverse/bsp_traverse.h).
+  BspSingleRays single_rays = BspSingleRays::Auto;
 };
 
 /// Accelerator names `make_tracer` accepts.

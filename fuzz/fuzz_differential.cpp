@@ -26,6 +26,7 @@
 #include "builder/accel_factory.h"
 #include "geometry/hit_compare.h"
 #include "robust/degenerate.h"
+#include "traverse/bsp_traverse.h"
 #include "traverse/cpu_features.h"
 
 namespace {
@@ -140,6 +141,23 @@ void expect_packets_equal(const char* accel, const bsprt::Tracer& t, std::span<c
   }
 }
 
+/// The interleaved single-ray kernel equals the sequential one bit for bit.
+void expect_interleaved_equal(bsprt::Tracer& t, std::span<const bsprt::Ray> rays) {
+  auto& bsp = dynamic_cast<bsprt::BspTracer&>(t);
+  std::vector<bsprt::Hit> seq(rays.size()), inter(rays.size());
+  bsp.set_single_rays(bsprt::BspSingleRays::Sequential);
+  bsp.trace_batch(rays, seq, 1);
+  bsp.set_single_rays(bsprt::BspSingleRays::Interleaved);
+  bsp.trace_batch(rays, inter, 1);
+  bsp.set_single_rays(bsprt::BspSingleRays::Auto);
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    if (std::memcmp(&seq[i], &inter[i], sizeof(bsprt::Hit)) != 0) {
+      std::fprintf(stderr, "bsp interleaved: ray %zu: sequential t=%a prim=%u, interleaved t=%a prim=%u\n", i,
+                   double(seq[i].t), seq[i].prim, double(inter[i].t), inter[i].prim);
+      __builtin_trap();
+    }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -158,5 +176,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   expect_agree("bsp vs brute", brute, trace(*bsp, rays));
   expect_packets_equal("kd", *kd, rays);
   expect_packets_equal("bsp", *bsp, rays);
+  expect_interleaved_equal(*bsp, rays);
   return 0;
 }

@@ -383,6 +383,68 @@ TEST_CASE("BSP packets equal single rays exactly", "[bsp]") {
   }
 }
 
+TEST_CASE("BSP interleaved single rays equal sequential ones exactly", "[bsp]") {
+  const TriangleSoup suzanne = load_mesh(scene_path("suzanne.obj"));
+  std::vector<std::pair<std::string, TriangleSoup>> scenes;
+  scenes.emplace_back("suzanne", suzanne);
+  scenes.emplace_back("suzanne + 1e5", transformed(suzanne, 1.0f, {1e5f, -1e5f, 1e5f}));
+  scenes.emplace_back("suzanne * 1e-4", transformed(suzanne, 1e-4f, {0, 0, 0}));
+  scenes.emplace_back("coplanar stack", make_coplanar_stack());
+  scenes.emplace_back("slivers", make_slivers());
+  scenes.emplace_back("default scene", make_default_scene());
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (const auto& [name, soup] : scenes) {
+    const BspScene s = build_bsp_scene(soup);
+    std::vector<Ray> rays = all_ray_sets(s.soup, 500, 13);
+    // Rays from inside the box with tnear < 0, and invalid rays, between ordinary ones.
+    const Box3f box = s.soup.bounds();
+    const Vec3f mid = (box.lo + box.hi) * 0.5f;
+    const std::size_t n = rays.size();
+    for (std::size_t i = 0; i < n; i += 3) rays.push_back({mid + (rays[i].org - mid) * 0.01f, -1e6f, rays[i].dir});
+    for (std::size_t i = 0; i < n; i += 50) {
+      rays.push_back({rays[i].org, 0, {nan, 1, 0}});
+      rays.push_back({rays[i].org, 0, {0, 0, 0}});
+      rays.push_back({{inf, 0, 0}, 0, rays[i].dir});
+    }
+    std::mt19937 rng(3);
+    std::shuffle(rays.begin(), rays.end(), rng);
+    for (BspEpsilon eps : {BspEpsilon::Certified, BspEpsilon::Zero}) {
+      BspTracer tracer(s.flat, s.soup, eps);
+      std::vector<Hit> one(rays.size());
+      for (std::size_t i = 0; i < rays.size(); ++i) one[i] = tracer.trace(rays[i]);
+      // Whole batch, and batches of fewer rays than lanes (3, 1, 0).
+      for (std::size_t batch : {rays.size(), std::size_t(3), std::size_t(1)}) {
+        for (BspSingleRays how : {BspSingleRays::Interleaved, BspSingleRays::Sequential, BspSingleRays::Auto}) {
+          tracer.set_single_rays(how);
+          std::vector<Hit> got(rays.size());
+          for (std::size_t b = 0; b < rays.size(); b += batch) {
+            const std::size_t m = std::min(batch, rays.size() - b);
+            tracer.trace_batch(std::span<const Ray>(rays.data() + b, m), std::span<Hit>(got.data() + b, m), 1);
+          }
+          std::size_t diff = 0;
+          for (std::size_t i = 0; i < rays.size(); ++i) diff += std::memcmp(&one[i], &got[i], sizeof(Hit)) != 0;
+          INFO(name << ", zero eps " << (eps == BspEpsilon::Zero) << ", batch " << batch << ", mode " << int(how));
+          CHECK(diff == 0);
+        }
+      }
+      tracer.set_single_rays(BspSingleRays::Interleaved);
+      std::vector<Hit> none;
+      tracer.trace_batch(std::span<const Ray>(), none, 1);
+      CHECK(std::count_if(one.begin(), one.end(), [](const Hit& h) { return h.hit(); }) > 0);
+    }
+  }
+}
+
+TEST_CASE("camera rays look coherent and random rays do not", "[bsp]") {
+  const TriangleSoup soup = load_mesh(scene_path("suzanne.obj"));
+  for (RaySetKind k : {RaySetKind::Random, RaySetKind::Vertex, RaySetKind::Edge})
+    CHECK_FALSE(rays_look_coherent(make_rays(k, soup, 4096, 5)));
+  const std::vector<Ray> primary = make_rays(RaySetKind::Primary, soup, 4096, 5);
+  CHECK(rays_look_coherent(primary));
+  CHECK(rays_look_coherent(std::span<const Ray>(primary.data(), 2)));
+  CHECK(rays_look_coherent(std::span<const Ray>()));
+}
+
 TEST_CASE("BSP rays from inside closed meshes never escape", "[bsp]") {
   for (const auto& [scale, shift] : {std::pair{1.0f, Vec3f{0, 0, 0}}, std::pair{1e-4f, Vec3f{0, 0, 0}},
                                      std::pair{1.0f, Vec3f{1e4f, -1e4f, 0}}}) {

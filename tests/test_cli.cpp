@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "geometry/hit_compare.h"
@@ -139,6 +140,25 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
   // The float BSP and kd-tree equal brute force (same watertight test) up to ties.
   CHECK(compare_hits(brute, bsp).agrees());
   CHECK(compare_hits(brute, kd_hits).agrees());
+  // --single-rays picks how bsp runs single rays; the hits files are the same bytes.
+  {
+    const auto read_bytes = [](const std::string& path) {
+      std::ifstream in(path, std::ios::binary);
+      return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const std::string bsp_bytes = read_bytes(temp_path("cli_suzanne_bsp.hits"));
+    REQUIRE_FALSE(bsp_bytes.empty());
+    for (const char* how : {"sequential", "interleaved"}) {
+      const std::string out = temp_path(std::string("cli_suzanne_single_") + how + ".hits");
+      const Run r = bsprt_cli("trace " + scene + " " + rays + " -o " + out + " --accel bsp --tree " + tree +
+                              " --single-rays " + how);
+      INFO(r.output);
+      REQUIRE(r.status == 0);
+      CHECK(read_bytes(out) == bsp_bytes);
+    }
+    CHECK(bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp --single-rays fast")
+              .status == 2);
+  }
   CHECK(bsprt_cli("compare " + temp_path("cli_suzanne_exact.hits") + " " + temp_path("cli_suzanne_bsp-certified.hits")).status == 0);
 
   // Under a box top of small subtrees (many boxes), the same guarantees, and

@@ -34,6 +34,25 @@ enum class BspEpsilon {
   Zero,
 };
 
+/// How BspTracer::trace_batch runs single rays. Every choice makes each ray's
+/// steps of trace() in the same order, so hits are the same bit for bit; only
+/// speed differs.
+enum class BspSingleRays {
+  /// Interleaved unless the batch looks coherent (rays_look_coherent).
+  Auto,
+  /// One ray after the other, the branchy loop of trace(): fastest on
+  /// coherent rays, whose branches the CPU predicts.
+  Sequential,
+  /// Eight rays in flight, each inner step choosing its child without a
+  /// branch: fastest on incoherent rays (random, secondary, vertex-aimed).
+  Interleaved,
+};
+
+/// Whether a batch looks coherent, like camera rays in tiles: at least half of
+/// up to 16 evenly spaced pairs of neighbouring rays have directions within
+/// about 8 degrees of each other. Picks the single-ray kernel only.
+bool rays_look_coherent(std::span<const Ray> rays);
+
 /// The flat BSP tree behind the Tracer interface. Copies the triangle corners
 /// it needs, so the soup need not outlive it.
 class BspTracer final : public Tracer {
@@ -56,10 +75,13 @@ class BspTracer final : public Tracer {
   /// Single ray, front to back; counts bsp_node_visits, kd_node_visits,
   /// leaf_visits, triangle_tests and rays when `counters` is non-null.
   Hit trace(const Ray& ray, RayCounters* counters = nullptr) const override;
-  /// packet_width 1 = single rays; 4, 8, 16 = SSE4.2, AVX2, AVX-512 packets
-  /// (UsageError when the CPU lacks the ISA). Each lane runs exactly the
-  /// single-ray steps (lanes that disagree on a node's near child wait on the
-  /// stack), so hits and counters equal single rays bit for bit.
+  /// packet_width 1 = single rays (run as set_single_rays says); 4, 8, 16 =
+  /// SSE4.2, AVX2, AVX-512 packets (UsageError when the CPU lacks the ISA).
+  /// Each lane runs exactly the single-ray steps (lanes that disagree on a
+  /// node's near child wait on the stack), so hits and counters equal single
+  /// rays bit for bit. With exact leaves or a box top packets run as single
+  /// rays; with counters, exact leaves or a box top single rays run
+  /// sequentially.
   void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width = 1,
                    RayCounters* counters = nullptr) const override;
   /// The tree cut into subtrees of at most `max_slots` slots, with their
@@ -69,6 +91,9 @@ class BspTracer final : public Tracer {
   /// BSP subtrees; packets then run as single rays.
   void set_box_top(BoxTop top);
   bool has_box_top() const { return has_top_; }
+  /// How trace_batch runs single rays (default Auto); not while tracing.
+  void set_single_rays(BspSingleRays how) { single_rays_ = how; }
+  BspSingleRays single_rays() const { return single_rays_; }
   const BoxTop& box_top() const { return top_; }
   /// Nodes, leaf lists, the copied triangles and the box top.
   std::size_t memory_bytes() const override;
@@ -85,6 +110,7 @@ class BspTracer final : public Tracer {
   std::vector<BspTriangle> triangles_;  ///< triangles_[i] = corners of tree_.prims[i]
   BoxTop top_;
   bool has_top_ = false;
+  BspSingleRays single_rays_ = BspSingleRays::Auto;
 };
 
 }  // namespace bsprt
