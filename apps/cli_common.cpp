@@ -27,8 +27,8 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
       ->check(CLI::Range(1u, 1u << 27))
       ->capture_default_str();
   cmd.add_option("--single-rays", o.single_rays,
-                 "bsp, bsp-zero-eps: how single rays run: auto (interleaved unless the rays look like camera "
-                 "rays), sequential or interleaved; the hits are the same")
+                 "bsp, bsp-zero-eps: how single rays run: auto (interleaved for incoherent rays with tfar = inf), "
+                 "sequential or interleaved; the hits are the same")
       ->check(CLI::IsMember({"auto", "sequential", "interleaved"}))
       ->capture_default_str();
   cmd.add_flag("--allow-nonfinite", o.allow_nonfinite,

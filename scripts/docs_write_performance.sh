@@ -79,8 +79,8 @@ Every number below is in the files of \`docs/perf/\` that the same run wrote.*
 | Embree | $(dpkg-query -W -f='${Version}' libembree-dev 2>/dev/null || echo "?") (Debian libembree-dev) |
 
 Modes (\`--accel\` names): **kd** SAH kd-tree; **bsp** exact BSP, float traversal with certified
-epsilons, watertight float triangle test (single rays: eight interleaved at a time unless a block
-looks like camera rays, docs/certified-epsilons.md §11); **bsp-top** the same tree under a 4-wide box top over
+epsilons, watertight float triangle test (single rays: eight interleaved at a time when a block
+is incoherent and unbounded, not camera rays, docs/certified-epsilons.md §11); **bsp-top** the same tree under a 4-wide box top over
 subtrees of ≤ 1024 slots (single rays only; docs/certified-epsilons.md §10);
 **bsp-zero-eps** the same tree with all epsilons 0;
 **bsp-certified** certified epsilons and leaves decided exactly (filtered, CGAL fallback);

@@ -435,7 +435,7 @@ TEST_CASE("BSP interleaved single rays equal sequential ones exactly", "[bsp]") 
   }
 }
 
-TEST_CASE("camera rays look coherent and random rays do not", "[bsp]") {
+TEST_CASE("camera rays look coherent and random rays do not and shadow segments are bounded", "[bsp]") {
   const TriangleSoup soup = load_mesh(scene_path("suzanne.obj"));
   for (RaySetKind k : {RaySetKind::Random, RaySetKind::Vertex, RaySetKind::Edge})
     CHECK_FALSE(rays_look_coherent(make_rays(k, soup, 4096, 5)));
@@ -443,6 +443,14 @@ TEST_CASE("camera rays look coherent and random rays do not", "[bsp]") {
   CHECK(rays_look_coherent(primary));
   CHECK(rays_look_coherent(std::span<const Ray>(primary.data(), 2)));
   CHECK(rays_look_coherent(std::span<const Ray>()));
+  // Generated rays are unbounded; segments (tfar finite, like shadow rays) are not.
+  for (RaySetKind k : {RaySetKind::Random, RaySetKind::Primary}) {
+    std::vector<Ray> rays = make_rays(k, soup, 4096, 5);
+    CHECK(rays_unbounded(rays));
+    for (Ray& r : rays) r.tfar = 1.0f;
+    CHECK_FALSE(rays_unbounded(rays));
+  }
+  CHECK_FALSE(rays_unbounded(std::span<const Ray>()));
 }
 
 TEST_CASE("BSP rays from inside closed meshes never escape", "[bsp]") {

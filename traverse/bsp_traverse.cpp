@@ -415,6 +415,14 @@ bool rays_look_coherent(std::span<const Ray> rays) {
   return 2 * close >= pairs;
 }
 
+bool rays_unbounded(std::span<const Ray> rays) {
+  if (rays.empty()) return false;
+  const std::size_t samples = std::min<std::size_t>(16, rays.size()), step = rays.size() / samples;
+  std::size_t unbounded = 0;
+  for (std::size_t p = 0; p < samples; ++p) unbounded += rays[p * step].tfar == std::numeric_limits<float>::infinity();
+  return 2 * unbounded >= samples;
+}
+
 Hit BspTracer::trace(const Ray& ray, RayCounters* counters) const {
   const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
   if (tree_.bounds.empty()) {
@@ -446,7 +454,8 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   if (need == Isa::Scalar || tree_.bounds.empty() || exact_leaf_ || has_top_) {
     const bool interleave = !counters && !exact_leaf_ && !has_top_ && !tree_.bounds.empty() &&
                             (single_rays_ == BspSingleRays::Interleaved ||
-                             (single_rays_ == BspSingleRays::Auto && !rays_look_coherent(rays)));
+                             (single_rays_ == BspSingleRays::Auto && !rays_look_coherent(rays) &&
+                              rays_unbounded(rays)));
     if (interleave) {
       trace_interleaved(v, rays.data(), rays.size(), hits.data());
       return;

@@ -38,13 +38,17 @@ enum class BspEpsilon {
 /// steps of trace() in the same order, so hits are the same bit for bit; only
 /// speed differs.
 enum class BspSingleRays {
-  /// Interleaved unless the batch looks coherent (rays_look_coherent).
+  /// Interleaved when the batch looks incoherent (not rays_look_coherent) and
+  /// its rays are unbounded (rays_unbounded); else sequential. Shadow rays
+  /// (short segments to a light) were slower interleaved
+  /// (docs/certified-epsilons.md §11).
   Auto,
   /// One ray after the other, the branchy loop of trace(): fastest on
   /// coherent rays, whose branches the CPU predicts.
   Sequential,
   /// Eight rays in flight, each inner step choosing its child without a
-  /// branch: fastest on incoherent rays (random, secondary, vertex-aimed).
+  /// branch: fastest on long incoherent rays (random, vertex- and
+  /// edge-aimed).
   Interleaved,
 };
 
@@ -52,6 +56,10 @@ enum class BspSingleRays {
 /// up to 16 evenly spaced pairs of neighbouring rays have directions within
 /// about 8 degrees of each other. Picks the single-ray kernel only.
 bool rays_look_coherent(std::span<const Ray> rays);
+
+/// Whether at least half of up to 16 evenly spaced rays of a batch have
+/// tfar = +inf (an empty batch: false). Picks the single-ray kernel only.
+bool rays_unbounded(std::span<const Ray> rays);
 
 /// The flat BSP tree behind the Tracer interface. Copies the triangle corners
 /// it needs, so the soup need not outlive it.
