@@ -403,24 +403,30 @@ BspView make_view(const FlatBspTree& t, const CompactBspTree& c, const std::vect
 }
 }  // namespace
 
+namespace {
+/// Whether test(i) holds for at least half of up to 16 evenly spaced i in [0, n).
+template <typename Test>
+bool half_of_samples(std::size_t n, Test test) {
+  const std::size_t samples = std::min<std::size_t>(16, n), step = n / samples;
+  std::size_t yes = 0;
+  for (std::size_t p = 0; p < samples; ++p) yes += test(p * step);
+  return 2 * yes >= samples;
+}
+}  // namespace
+
 bool rays_look_coherent(std::span<const Ray> rays) {
   if (rays.size() < 2) return true;
-  const std::size_t pairs = std::min<std::size_t>(16, rays.size() - 1), step = (rays.size() - 1) / pairs;
-  std::size_t close = 0;
-  for (std::size_t p = 0; p < pairs; ++p) {
-    const Vec3f a = rays[p * step].dir, b = rays[p * step + 1].dir;
+  return half_of_samples(rays.size() - 1, [&](std::size_t i) {
+    const Vec3f a = rays[i].dir, b = rays[i + 1].dir;
     const float ab = dot(a, b);  // cos^2 > 0.98: within about 8 degrees; NaN: not close
-    close += ab > 0.0f && ab * ab > 0.98f * dot(a, a) * dot(b, b);
-  }
-  return 2 * close >= pairs;
+    return ab > 0.0f && ab * ab > 0.98f * dot(a, a) * dot(b, b);
+  });
 }
 
 bool rays_unbounded(std::span<const Ray> rays) {
-  if (rays.empty()) return false;
-  const std::size_t samples = std::min<std::size_t>(16, rays.size()), step = rays.size() / samples;
-  std::size_t unbounded = 0;
-  for (std::size_t p = 0; p < samples; ++p) unbounded += rays[p * step].tfar == std::numeric_limits<float>::infinity();
-  return 2 * unbounded >= samples;
+  return !rays.empty() && half_of_samples(rays.size(), [&](std::size_t i) {
+    return rays[i].tfar == std::numeric_limits<float>::infinity();
+  });
 }
 
 Hit BspTracer::trace(const Ray& ray, RayCounters* counters) const {
