@@ -124,6 +124,8 @@ PlyHeader parse_ply_header(const std::string& path, const std::string& bytes) {
       if (h.elements.empty()) throw InputError(path, no, "PLY property before any element");
       add_property(path, no, line, i, h.elements.back());
     } else if (kw == "end_header") {
+      if (!next_token(line, i).empty())
+        throw InputError(path, no, "PLY end_header line must hold only 'end_header' (the body starts on the next line)");
       break;
     } else if (kw != "comment" && kw != "obj_info" && !kw.empty()) {
       throw InputError(path, no, "unknown PLY header keyword " + quote(kw));

@@ -21,13 +21,13 @@ class LineCursor {
     std::size_t stop = end;
     if (stop > pos_ && text_[stop - 1] == '\r') --stop;
     line = text_.substr(pos_, stop - pos_);
-    pos_ = end + 1;
+    pos_ = end == text_.size() ? end : end + 1;  // a last line without '\n' ends at the buffer's end
     number_ = next_number_++;
     return true;
   }
   /// 1-based number of the line last returned.
   std::int64_t number() const { return number_; }
-  /// Offset just past the line last returned.
+  /// Offset just past the line last returned (and its '\n'); never past the end.
   std::size_t offset() const { return pos_; }
 
  private:

@@ -2,11 +2,16 @@
 // failure becomes one test here, with the input written out in code.
 #include <catch2/catch.hpp>
 
+#include <fstream>
+#include <utility>
+
 #include "geometry/default_scene.h"
 #include "geometry/error.h"
+#include "geometry/load_mesh.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 #include "stiff_util.h"
+#include "test_util.h"
 
 using namespace bsprt;
 using namespace bsprt::test;
@@ -98,4 +103,37 @@ TEST_CASE("exact reference: candidates come from the exact ray when o + d rounds
     CHECK(h.prim == 0);
     CHECK(h.t == 0x1p40f);
   }
+}
+
+// Found by fuzz_load_mesh in CI (2026-11-22): a PLY whose last line is
+// "end_header 4 0 0er " with no newline after it. LineCursor put the body one
+// byte past the end of the buffer, and the ascii body reader's substr threw
+// std::out_of_range (not an InputError). Now the cursor stops at the end, and
+// extra tokens on the end_header line are an error with its line number.
+TEST_CASE("mesh loader: a PLY ending on its end_header line is an InputError", "[regression]") {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\n";
+  const auto load_error = [](const std::string& name, const std::string& bytes) -> std::pair<std::string, std::int64_t> {
+    const std::string path = temp_path(name);
+    std::ofstream(path, std::ios::binary) << bytes;
+    try {
+      load_mesh(path);
+    } catch (const InputError& e) {
+      CHECK(e.file() == path);
+      return {e.what(), e.line()};
+    }
+    return {"", -1};
+  };
+  // The fuzzer's input, byte for byte (after its format byte).
+  const auto fuzzed = load_error("end_header_tokens.ply", head + "end_header 4 0 0er ");
+  CHECK(fuzzed.first.find("end_header") != std::string::npos);
+  CHECK(fuzzed.second == 9);
+  // The same without the stray tokens: the body is empty, so the file ends inside vertex 0.
+  const auto bare = load_error("end_header_eof.ply", head + "end_header");
+  CHECK(bare.first.find("file ends inside vertex 0") != std::string::npos);
+  // Binary: no body at all is a truncation, not a read past the end.
+  std::string bin = head + "end_header";
+  bin.replace(bin.find("ascii"), 5, "binary_little_endian");
+  CHECK(load_error("end_header_eof_bin.ply", bin).first.find("truncated") != std::string::npos);
 }
