@@ -178,12 +178,21 @@ inline void ray_setup_core(const F (&o)[3], const F (&dir)[3], const Box3f& root
   const F err_o = safe ? (certified ? kErrCoef * mo + kErrAbs : F{})
                        : F{} + std::numeric_limits<float>::infinity();
   const F err_d = certified ? kErrCoef * md + kErrAbs : F{};
+  // The slab crossings' max (min) is widened once: widen_dn and widen_up are
+  // monotone, so this equals the max (min) of the widened crossings, bit for
+  // bit. NaN crossings do not clip (a comparison with NaN keeps the bound).
+  const F inf = F{} + std::numeric_limits<float>::infinity();
+  F enter = -inf, exit = inf;
   for (int k = 0; k < 3; ++k) {
     const F ta = (root.lo[k] - o[k]) * inv[k], tb = (root.hi[k] - o[k]) * inv[k];
-    const F enter = widen_dn(neg[k] ? tb : ta), exit = widen_up(neg[k] ? ta : tb);
-    tmin = enter > tmin ? enter : tmin;
-    tmax = exit < tmax ? exit : tmax;
+    const F e = neg[k] ? tb : ta, x = neg[k] ? ta : tb;
+    enter = e > enter ? e : enter;
+    exit = x < exit ? x : exit;
   }
+  enter = widen_dn(enter);
+  exit = widen_up(exit);
+  tmin = enter > tmin ? enter : tmin;
+  tmax = exit < tmax ? exit : tmax;
   const F at0 = gabs(tmin), at1 = gabs(tmax);
   err = err_o + err_d * (at0 > at1 ? at0 : at1);
 }
