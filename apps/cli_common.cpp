@@ -1,5 +1,7 @@
 #include "apps/cli_common.h"
 
+#include <vector>
+
 #include <fmt/core.h>
 
 #include "apps/progress.h"
@@ -69,7 +71,37 @@ std::unique_ptr<tbb::global_control> limit_threads(int threads) {
                                                std::size_t(threads));
 }
 
+std::vector<std::string> ignored_options(const TraceOptions& o) {
+  const TraceOptions defaults;
+  std::vector<std::string> ignored;
+  if (o.single_rays != defaults.single_rays && o.accel != "bsp" && o.accel != "bsp-zero-eps")
+    ignored.push_back("--single-rays (bsp, bsp-zero-eps only)");
+  if (o.top_slots != defaults.top_slots && o.accel != "bsp-top" && o.accel != "bsp-top-certified")
+    ignored.push_back("--top-slots (bsp-top, bsp-top-certified only)");
+  if (o.membership != defaults.membership && (o.accel.rfind("bsp", 0) != 0 || !o.tree.empty()))
+    ignored.push_back(o.tree.empty() ? "--membership (BSP accelerators only)"
+                                     : "--membership (a BSP built in memory only; the tree file fixed it when it was "
+                                       "built: bsprt build --membership)");
+  return ignored;
+}
+
+TraceOptions without_ignored_options(TraceOptions o) {
+  const TraceOptions defaults;
+  for (const std::string& name : ignored_options(o)) {
+    if (name.rfind("--single-rays", 0) == 0) o.single_rays = defaults.single_rays;
+    if (name.rfind("--top-slots", 0) == 0) o.top_slots = defaults.top_slots;
+    if (name.rfind("--membership", 0) == 0) o.membership = defaults.membership;
+  }
+  return o;
+}
+
 std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& soup) {
+  const std::vector<std::string> ignored = ignored_options(o);
+  if (!ignored.empty()) {
+    std::string list;
+    for (const std::string& name : ignored) list += (list.empty() ? "" : ", ") + name;
+    throw UsageError("--accel " + o.accel + " does not use " + list);
+  }
   AccelOptions options;
   options.tree_path = o.tree;
   options.threads = o.threads;

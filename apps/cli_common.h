@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "builder/accel_factory.h"
 #include "geometry/load_mesh.h"
@@ -41,7 +42,16 @@ BspMembership parse_membership(const std::string& name);
 /// Caps TBB's worker threads for the life of the returned object (0 = all cores).
 std::unique_ptr<tbb::global_control> limit_threads(int threads);
 
-/// Builds or loads the accelerator named in `o`, with a progress bar on a terminal.
+/// The options given a non-default value in `o` that `o.accel` would not use,
+/// each with the accelerators it is for; empty when all apply.
+std::vector<std::string> ignored_options(const TraceOptions& o);
+
+/// `o` with the options ignored_options() lists set back to their defaults
+/// (render --heat-compare hands the first accelerator's options to a second one).
+TraceOptions without_ignored_options(TraceOptions o);
+
+/// Builds or loads the accelerator named in `o`, with a progress bar on a
+/// terminal; throws UsageError when an option given is one `o.accel` ignores.
 std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& soup);
 
 /// Registration of each subcommand (one file each).

@@ -107,7 +107,7 @@ void run_heat(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& sou
     TraceOptions other = a.trace;
     other.accel = a.heat_compare;
     other.tree.clear();
-    const std::unique_ptr<Tracer> b = make_accel(other, soup);
+    const std::unique_ptr<Tracer> b = make_accel(without_ignored_options(other), soup);
     const std::vector<float> cost_b = pixel_costs(*b, options, metric);
     image = heat_difference_image(cost, cost_b, options.width, options.height,
                                   fmt::format("{} - {}\n{}", tracer.name(), b->name(), heat_metric_name(metric)));

@@ -238,3 +238,55 @@ TEST_CASE("build --accel bsp with other SAH constants is certified and equals br
     CHECK(r.output.find(bad.substr(0, bad.find(' '))) != std::string::npos);
   }
 }
+
+TEST_CASE("an option the chosen accelerator would ignore is a usage error", "[cli]") {
+  const std::string scene = scene_path("cube.obj");
+  const std::string rays = temp_path("cli_ignored.rays"), tree = temp_path("cli_ignored_cube.bsp");
+  REQUIRE(bsprt_cli("gen-rays " + scene + " --kind random -n 100 --seed 5 -o " + rays).status == 0);
+  REQUIRE(bsprt_cli("build " + scene + " -o " + tree + " --accel bsp").status == 0);
+  const std::string out = temp_path("cli_ignored.hits");
+  const auto trace = [&](const std::string& extra) {
+    std::filesystem::remove(out);
+    return bsprt_cli("trace " + scene + " " + rays + " -o " + out + " " + extra);
+  };
+  struct Case {
+    std::string options, message;
+  };
+  for (const Case& c : {Case{"--accel bsp-top --single-rays interleaved", "does not use --single-rays"},
+                        Case{"--accel bsp-top-certified --single-rays sequential", "does not use --single-rays"},
+                        Case{"--accel embree --single-rays sequential", "does not use --single-rays"},
+                        Case{"--accel bsp --top-slots 4", "does not use --top-slots"},
+                        Case{"--accel kd --top-slots 4", "does not use --top-slots"},
+                        Case{"--accel kd --membership closed", "does not use --membership"},
+                        Case{"--accel bsp --tree " + tree + " --membership closed", "tree file fixed it"},
+                        Case{"--accel brute --single-rays interleaved --top-slots 8",
+                             "does not use --single-rays (bsp, bsp-zero-eps only), --top-slots"}}) {
+    const Run r = trace(c.options);
+    INFO(c.options << "\n" << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(c.message) != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(out));  // refused before tracing
+  }
+  // The same options where they apply, and default values anywhere, are accepted.
+  for (const std::string& ok :
+       {std::string("--accel bsp --single-rays interleaved"), std::string("--accel bsp-zero-eps --single-rays sequential"),
+        std::string("--accel bsp-top --top-slots 4"), std::string("--accel bsp-top-certified --top-slots 4"),
+        std::string("--accel bsp --membership closed"), std::string("--accel embree --single-rays auto --top-slots 1024 --membership area")}) {
+    const Run r = trace(ok);
+    INFO(ok << "\n" << r.output);
+    CHECK(r.status == 0);
+    CHECK(std::filesystem::exists(out));
+  }
+  // render takes the same options and gives the same error.
+  const Run render = bsprt_cli("render " + scene + " -o " + temp_path("cli_ignored.png") +
+                               " --size 8 8 --accel kd --single-rays interleaved");
+  INFO(render.output);
+  CHECK(render.status == 2);
+  CHECK(render.output.find("does not use --single-rays") != std::string::npos);
+  // --heat-compare hands the options to a second accelerator only where they apply.
+  const Run heat = bsprt_cli("render " + scene + " -o " + temp_path("cli_ignored_heat.png") +
+                             " --size 8 8 --mode heat --accel bsp-top --top-slots 4 --heat-compare bsp");
+  INFO(heat.output);
+  CHECK(heat.status == 0);
+  CHECK(heat.output.find("heat map") != std::string::npos);
+}
