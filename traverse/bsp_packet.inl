@@ -40,13 +40,15 @@ struct BspPacketEntry {
   vmask<W> popped;  ///< of those, lanes with a real (single-ray) stack entry
 };
 
-/// Per-lane constants of bsp_ray_setup in SoA form.
+/// Per-lane constants of bsp_ray_setup in SoA form, and the rays' own
+/// segments (tnear, tfar) for the triangle test.
 template <int W>
 struct BspPacketRay {
   vfloat<W> o[3], dir[3], inv[3];
   vmask<W> neg[3];
   vfloat<W> err;
   vfloat<W> tmin, tmax;
+  vfloat<W> tnear, tfar;
   vmask<W> live;
 };
 
@@ -66,6 +68,7 @@ inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count
     for (int k = 0; k < 3; ++k) p.o[k][i] = ray.org[k], p.dir[k][i] = ray.dir[k];
     p.tmin[i] = ray.tnear, p.tmax[i] = ray.tfar;
   }
+  p.tnear = p.tmin, p.tfar = p.tmax;
   const vmask<W> valid = valid_lanes<W>(p.o, p.dir, p.tmin, p.tmax);
   detail::ray_setup_core(p.o, p.dir, v.bounds, v.certified, p.inv, p.neg, p.tmin, p.tmax, p.err);
   p.live = valid & (p.tmin <= p.tmax);
@@ -101,10 +104,13 @@ inline vmask<W> cut_node(const CompactBspSlot& n, const BspPacketRay<W>& r, vflo
   return r.neg[k];
 }
 
-/// Traverses one packet; lanes not live stay misses.
+/// Traverses one packet; lanes not live stay misses. The triangle test's
+/// precomputation is made at the first leaf: most packets of a camera that
+/// frames the scene never reach one.
 template <int W, bool kCount>
-void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPacket<W>& pre,
-                  PacketHit<W>& hit, RayCounters* c) {
+void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit, RayCounters* c) {
+  WatertightPacket<W> pre;
+  bool have_pre = false;
   vfloat<W> tmin = r.tmin, tmax = r.tmax;
   vmask<W> active = r.live;
   BspPacketEntry<W> stack[kBspPacketStack];
@@ -162,7 +168,13 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, const WatertightPa
       }
       n = &v.nodes[node];
     }
-    if (leaf) packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
+    if (leaf) {
+      if (!have_pre) {
+        pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
+        have_pre = true;
+      }
+      packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
+    }
     for (;;) {
       if (sp == 0) return;
       const BspPacketEntry<W>& e = stack[--sp];
@@ -180,12 +192,10 @@ template <int W, bool kCount>
 void trace_packets(const BspView& v, const Ray* rays, std::size_t n, Hit* hits, RayCounters* c) {
   for (std::size_t base = 0; base < n; base += W) {
     const int count = n - base < std::size_t(W) ? int(n - base) : W;
-    const WatertightPacket<W> pre =
-        watertight_precompute_packet<W>(std::span<const Ray>(rays + base, std::size_t(count)));
     const BspPacketRay<W> r = packet_setup<W>(v, rays + base, count);
     if constexpr (kCount) c->rays += std::uint64_t(count);
     PacketHit<W> hit = packet_miss<W>();
-    if (any<W>(r.live)) trace_packet<W, kCount>(v, r, pre, hit, c);
+    if (any<W>(r.live)) trace_packet<W, kCount>(v, r, hit, c);
     store_hits<W>(hit, std::span<Hit>(hits + base, std::size_t(count)));
   }
 }

@@ -76,17 +76,24 @@ inline void packet_leaf(const KdView& v, const KdNode& n, const WatertightPacket
   }
 }
 
-/// Traverses one coherent packet; lanes not in `active` stay misses.
+/// W rays in SoA form; lanes past the packet's rays have a zero direction.
+template <int W>
+struct KdPacketLanes {
+  vfloat<W> o[3] = {}, dir[3] = {}, tnear = {}, tfar = {};
+  vmask<W> valid;  ///< valid_lanes: padding lanes are not valid
+};
+
+/// Traverses one coherent packet; lanes not valid stay misses. The triangle
+/// test's precomputation is made at the first leaf: most packets of a camera
+/// that frames the scene never reach one.
 template <int W, bool kCount>
-void trace_packet(const KdView& v, const Ray* rays, int count, const bool neg[3],
-                  const WatertightPacket<W>& pre, PacketHit<W>& hit, RayCounters* c) {
-  vfloat<W> o[3], inv[3], tmin, tmax;
-  for (int i = 0; i < W; ++i) {
-    const Ray& r = rays[i < count ? i : 0];
-    for (int k = 0; k < 3; ++k) o[k][i] = r.org[k], inv[k][i] = r.dir[k];
-    tmin[i] = r.tnear, tmax[i] = r.tfar;
-  }
-  for (int k = 0; k < 3; ++k) inv[k] = 1.0f / inv[k];
+void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3], PacketHit<W>& hit,
+                  RayCounters* c) {
+  WatertightPacket<W> pre;
+  bool have_pre = false;
+  const vfloat<W>(&o)[3] = r.o;
+  vfloat<W> inv[3], tmin = r.tnear, tmax = r.tfar;
+  for (int k = 0; k < 3; ++k) inv[k] = 1.0f / r.dir[k];  // padding lanes: inf, never active
   for (int k = 0; k < 3; ++k) {  // clip_root
     const vfloat<W> t0 = (v.bounds.lo[k] - o[k]) * inv[k], t1 = (v.bounds.hi[k] - o[k]) * inv[k];
     vfloat<W> enter, exit, unused;
@@ -95,7 +102,7 @@ void trace_packet(const KdView& v, const Ray* rays, int count, const bool neg[3]
     tmin = enter > tmin ? enter : tmin;
     tmax = exit < tmax ? exit : tmax;
   }
-  vmask<W> active = pre.valid & (tmin <= tmax);
+  vmask<W> active = r.valid & (tmin <= tmax);
   if (none<W>(active)) return;
   KdPacketEntry<W> stack[kKdMaxDepth];
   int sp = 0;
@@ -126,7 +133,13 @@ void trace_packet(const KdView& v, const Ray* rays, int count, const bool neg[3]
       }
       n = &v.nodes[node];
     }
-    if (n->is_leaf()) packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
+    if (n->is_leaf()) {
+      if (!have_pre) {
+        pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
+        have_pre = true;
+      }
+      packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
+    }
     for (;;) {
       if (sp == 0) return;
       const KdPacketEntry<W>& e = stack[--sp];
@@ -145,16 +158,21 @@ void trace_packets(const KdView& v, const Ray* rays, std::size_t n, Hit* hits, R
                    detail::KdSingleFn single) {
   for (std::size_t base = 0; base < n; base += W) {
     const int count = n - base < std::size_t(W) ? int(n - base) : W;
-    const WatertightPacket<W> pre =
-        watertight_precompute_packet<W>(std::span<const Ray>(rays + base, std::size_t(count)));
+    KdPacketLanes<W> r;
+    for (int i = 0; i < count; ++i) {
+      const Ray& ray = rays[base + i];
+      for (int k = 0; k < 3; ++k) r.o[k][i] = ray.org[k], r.dir[k][i] = ray.dir[k];
+      r.tnear[i] = ray.tnear, r.tfar[i] = ray.tfar;
+    }
+    r.valid = valid_lanes<W>(r.o, r.dir, r.tnear, r.tfar);
     bool neg[3] = {false, false, false};
-    if (!coherent_signs<W>(rays + base, count, pre.valid, neg)) {
+    if (!coherent_signs<W>(rays + base, count, r.valid, neg)) {
       for (int i = 0; i < count; ++i) hits[base + i] = single(v, rays[base + i], c);
       continue;
     }
     if constexpr (kCount) c->rays += std::uint64_t(count);
     PacketHit<W> hit = packet_miss<W>();
-    if (any<W>(pre.valid)) trace_packet<W, kCount>(v, rays + base, count, neg, pre, hit, c);
+    if (any<W>(r.valid)) trace_packet<W, kCount>(v, r, neg, hit, c);
     store_hits<W>(hit, std::span<Hit>(hits + base, std::size_t(count)));
   }
 }

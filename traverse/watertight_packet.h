@@ -93,19 +93,16 @@ inline vfloat<W> pick(const vfloat<W> (&a)[3], vint<W> k) {
 }
 }  // namespace watertight_detail
 
-/// Precomputes a packet from up to W rays (rays.size() <= W); lanes past the
-/// end are invalid. watertight_precompute on vectors: the same axis choice
+/// Precomputes a packet of W rays in SoA form; lanes failing valid_lanes are
+/// invalid. watertight_precompute on vectors: the same axis choice
 /// (max_axis) and the same divisions, so each valid lane equals the scalar
 /// precomputation; invalid lanes are never tested.
 template <int W>
-inline WatertightPacket<W> watertight_precompute_packet(std::span<const Ray> rays) {
+inline WatertightPacket<W> watertight_precompute_soa(const vfloat<W> (&org)[3], const vfloat<W> (&dir)[3],
+                                                    vfloat<W> tnear, vfloat<W> tfar) {
   WatertightPacket<W> p{};
-  vfloat<W> dir[3] = {};  // lanes past the end: zero direction, so not valid
-  p.tfar = splat<W>(std::numeric_limits<float>::infinity());
-  for (std::size_t i = 0; i < rays.size() && i < std::size_t(W); ++i) {
-    for (int k = 0; k < 3; ++k) p.org[k][i] = rays[i].org[k], dir[k][i] = rays[i].dir[k];
-    p.tnear[i] = rays[i].tnear, p.tfar[i] = rays[i].tfar;
-  }
+  for (int k = 0; k < 3; ++k) p.org[k] = org[k];
+  p.tnear = tnear, p.tfar = tfar;
   p.valid = valid_lanes<W>(p.org, dir, p.tnear, p.tfar);
   // max_axis: x if |x| >= |y| and |x| >= |z|, else y if |y| >= |z|, else z.
   const vfloat<W> ax = abs<W>(dir[0]), ay = abs<W>(dir[1]), az = abs<W>(dir[2]);
@@ -131,6 +128,18 @@ inline WatertightPacket<W> watertight_precompute_packet(std::span<const Ray> ray
     p.uniform = (movemask<W>(same) & vm) == vm;
   }
   return p;
+}
+
+/// The same from AoS rays; lanes past the end have a zero direction (not valid).
+template <int W>
+inline WatertightPacket<W> watertight_precompute_packet(std::span<const Ray> rays) {
+  vfloat<W> org[3] = {}, dir[3] = {};
+  vfloat<W> tnear = {}, tfar = splat<W>(std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < rays.size() && i < std::size_t(W); ++i) {
+    for (int k = 0; k < 3; ++k) org[k][i] = rays[i].org[k], dir[k][i] = rays[i].dir[k];
+    tnear[i] = rays[i].tnear, tfar[i] = rays[i].tfar;
+  }
+  return watertight_precompute_soa<W>(org, dir, tnear, tfar);
 }
 
 /// Precomputes a packet from SoA rays; lanes off in `active` are invalid.
