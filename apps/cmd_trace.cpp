@@ -16,6 +16,7 @@
 #include "builder/tree_file.h"
 #include "geometry/error.h"
 #include "geometry/ray_io.h"
+#include "traverse/embree_tracer.h"
 
 namespace bsprt::cli {
 namespace {
@@ -72,6 +73,10 @@ void run(const TraceArgs& a) {
   if (a.face_hits) check_face_hits_usage(a);
   const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, !a.json);
   const std::vector<Ray> rays = read_rays(a.rays);
+  if (a.trace.accel.rfind("embree", 0) == 0)  // the file's own ray numbers, before the build
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if (const char* why = embree_cannot_trace(rays[i]))
+        throw UsageError(a.rays + ": ray " + std::to_string(i) + " has " + why + "; trace it with kd, bsp, brute or exact");
   const auto t0 = std::chrono::steady_clock::now();
   const std::unique_ptr<Tracer> tracer = make_accel(a.trace, soup);
   const auto t1 = std::chrono::steady_clock::now();

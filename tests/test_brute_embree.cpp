@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/error.h"
 #include "geometry/load_mesh.h"
 #include "geometry/ray.h"
 #include "geometry/triangle_soup.h"
@@ -150,4 +151,47 @@ TEST_CASE("embree: degenerate triangles, numbering, invalid rays, modes", "[embr
   Ray r;
   r.dir = {1, 0, 0};
   CHECK_FALSE(e.trace(r).hit());
+}
+
+// Regression: a valid ray with tnear < 0 (or a component above Embree's
+// FLT_LARGE) aborted the process in Embree's assertion "ray.tnear() >= 0.0f"
+// (found tracing the stiff special rays with --accel embree).
+TEST_CASE("embree: a valid ray Embree cannot trace is a usage error naming it and not a crash", "[embree][regression]") {
+  TriangleSoup s;
+  s.vertices = {{-1, -1, 6}, {3, -1, 6}, {-1, 3, 6}};
+  s.triangles = {{0, 1, 2}};
+  s.degenerate = {0};
+  const EmbreeTracer e(s);
+  Ray ok;
+  ok.org = {0, 0, 0}, ok.dir = {0, 0, 1};
+  const auto bad_rays = [&] {
+    std::vector<Ray> bad(3, ok);
+    bad[0].tnear = -1.0f;
+    bad[1].org.x = 1e19f;
+    bad[2].dir.y = -1e19f;
+    return bad;
+  }();
+  for (const Ray& bad : bad_rays) {
+    CHECK_THROWS_AS(e.trace(bad), UsageError);
+    for (int w : {1, 4, 8, 16}) {
+      std::vector<Ray> rays(20, ok);
+      rays[13] = bad;
+      std::vector<Hit> hits(rays.size());
+      try {
+        e.trace_batch(rays, hits, w);
+        FAIL("no error for width " << w);
+      } catch (const UsageError& err) {
+        CHECK(std::string(err.what()).find("ray 13 ") != std::string::npos);
+      }
+      for (const Hit& h : hits) CHECK_FALSE(h.hit());  // refused before tracing
+    }
+  }
+  // At the limit, and invalid rays with a negative tnear (tnear > tfar), are traced as before.
+  Ray edge = ok;
+  edge.dir = {0, 0, 1e18f};
+  CHECK(e.trace(edge).hit());
+  CHECK(e.trace(edge).t == Approx(6e-18f));
+  Ray invalid = ok;
+  invalid.tnear = -1.0f, invalid.tfar = -2.0f;
+  CHECK_FALSE(e.trace(invalid).hit());
 }

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "geometry/hit_compare.h"
 #include "geometry/ray_io.h"
@@ -289,4 +290,30 @@ TEST_CASE("an option the chosen accelerator would ignore is a usage error", "[cl
   INFO(heat.output);
   CHECK(heat.status == 0);
   CHECK(heat.output.find("heat map") != std::string::npos);
+}
+
+// Regression: `trace --accel embree` aborted the process on a valid ray with
+// tnear < 0 (Embree's assertion); now a usage error naming the file and ray.
+TEST_CASE("trace --accel embree refuses a ray Embree cannot trace with its number in the file", "[cli][regression]") {
+  const std::string scene = scene_path("cube.obj");
+  std::vector<Ray> rays(3);
+  for (Ray& r : rays) r.org = {0.1f, 0.2f, -5.0f}, r.dir = {0, 0, 1};
+  rays[1].tnear = -1.0f;
+  const std::string file = temp_path("cli_embree_negative_tnear.rays"), out = temp_path("cli_embree_negative.hits");
+  write_rays(file, rays);
+  for (const char* accel : {"embree", "embree-fast"}) {
+    for (const char* packets : {"1", "16"}) {
+      std::filesystem::remove(out);
+      const Run r = bsprt_cli("trace " + scene + " " + file + " -o " + out + " --accel " + accel + " --packets " + packets);
+      INFO(r.output);
+      CHECK(r.status == 2);
+      CHECK(r.output.find(file + ": ray 1 has tnear < 0") != std::string::npos);
+      CHECK_FALSE(std::filesystem::exists(out));
+    }
+  }
+  // The same file traces with the other accelerators, ray 1 reaching behind its origin.
+  const Run kd = bsprt_cli("trace " + scene + " " + file + " -o " + out + " --accel kd");
+  INFO(kd.output);
+  CHECK(kd.status == 0);
+  CHECK(read_hits(out).size() == 3);
 }

@@ -13,6 +13,7 @@
 #include <embree3/rtcore.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -132,7 +133,27 @@ void trace_packet(const EmbreeState& impl, std::span<const Ray> rays, std::span<
   }
 }
 
+/// Embree's FLT_LARGE (common/sys/platform.h): RayK::valid() asserts |org| and
+/// |dir| components at most this.
+constexpr float kEmbreeLarge = 1.844E18f;
+
+/// Throws UsageError naming ray `index` (of the batch) when Embree cannot trace it.
+void check_embree_domain(const Ray& r, std::size_t index) {
+  if (const char* why = embree_cannot_trace(r))
+    throw UsageError("embree: ray " + std::to_string(index) + " has " + why +
+                     "; the .rays format allows it: trace it with kd, bsp, brute or exact");
+}
+
 }  // namespace
+
+const char* embree_cannot_trace(const Ray& r) {
+  if (!is_valid(r)) return nullptr;
+  if (!(r.tnear >= 0.0f)) return "tnear < 0 (Embree traces only tnear >= 0)";
+  for (int k = 0; k < 3; ++k)
+    if (std::fabs(r.org[k]) > kEmbreeLarge || std::fabs(r.dir[k]) > kEmbreeLarge)
+      return "an origin or direction component above 1.844e18 in magnitude (Embree's limit)";
+  return nullptr;
+}
 
 struct EmbreeTracer::Impl : EmbreeState {};
 
@@ -161,6 +182,7 @@ std::string EmbreeTracer::name() const { return impl_->config.robust ? "embree" 
 Hit EmbreeTracer::trace(const Ray& ray, RayCounters* counters) const {
   if (counters) ++counters->rays;
   if (!is_valid(ray)) return Hit{};
+  check_embree_domain(ray, 0);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh = to_embree(ray);
@@ -176,6 +198,7 @@ void EmbreeTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, i
                      std::to_string(hits.size()) + " hits");
   if (packet_width != 1 && packet_width != 4 && packet_width != 8 && packet_width != 16)
     throw UsageError("packet width must be 1, 4, 8 or 16, not " + std::to_string(packet_width));
+  for (std::size_t i = 0; i < rays.size(); ++i) check_embree_domain(rays[i], i);  // before any ray is traced
   if (packet_width == 1) {
     for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
     return;

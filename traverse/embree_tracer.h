@@ -17,8 +17,17 @@ struct EmbreeConfig {
   bool high_quality = true;  ///< RTC_BUILD_QUALITY_HIGH (SAH with spatial splits)
 };
 
+/// Why Embree cannot trace the valid ray `r`, or nullptr when it can (or `r`
+/// is invalid, a miss without Embree). Embree asserts tnear >= 0 and origin
+/// and direction components at most 1.844e18 (FLT_LARGE) in magnitude; Debian's
+/// build keeps the assertions, so such a ray would abort the process.
+const char* embree_cannot_trace(const Ray& r);
+
 /// Embree 3 scene over the soup. Degenerate triangles are not given to Embree;
-/// a table maps Embree primIDs back to our triangle numbers.
+/// a table maps Embree primIDs back to our triangle numbers. Invalid rays
+/// (is_valid) are misses; a valid ray Embree cannot trace (tnear < 0, or an
+/// origin or direction component above 1.844e18 in magnitude) is a UsageError
+/// naming it (index within the batch), thrown before any ray of the batch is traced.
 class EmbreeTracer final : public Tracer {
  public:
   EmbreeTracer(const TriangleSoup& soup, const EmbreeConfig& config = {});
