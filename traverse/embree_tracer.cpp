@@ -141,7 +141,7 @@ constexpr float kEmbreeLarge = 1.844E18f;
 void check_embree_domain(const Ray& r, std::size_t index) {
   if (const char* why = embree_cannot_trace(r))
     throw UsageError("embree: ray " + std::to_string(index) + " has " + why +
-                     "; the .rays format allows it: trace it with kd, bsp, brute or exact");
+                     "; such a ray is valid (formats.md): kd, bsp, brute and exact trace it");
 }
 
 }  // namespace
