@@ -71,14 +71,26 @@ std::unique_ptr<tbb::global_control> limit_threads(int threads) {
                                                std::size_t(threads));
 }
 
+namespace {
+/// Which of the accelerator-specific options `o.accel` uses.
+struct UsedOptions {
+  bool single_rays, top_slots, membership;
+};
+UsedOptions used_options(const TraceOptions& o) {
+  return {o.accel == "bsp" || o.accel == "bsp-zero-eps", o.accel == "bsp-top" || o.accel == "bsp-top-certified",
+          o.accel.rfind("bsp", 0) == 0 && o.tree.empty()};
+}
+}  // namespace
+
 std::vector<std::string> ignored_options(const TraceOptions& o) {
   const TraceOptions defaults;
+  const UsedOptions used = used_options(o);
   std::vector<std::string> ignored;
-  if (o.single_rays != defaults.single_rays && o.accel != "bsp" && o.accel != "bsp-zero-eps")
+  if (o.single_rays != defaults.single_rays && !used.single_rays)
     ignored.push_back("--single-rays (bsp, bsp-zero-eps only)");
-  if (o.top_slots != defaults.top_slots && o.accel != "bsp-top" && o.accel != "bsp-top-certified")
+  if (o.top_slots != defaults.top_slots && !used.top_slots)
     ignored.push_back("--top-slots (bsp-top, bsp-top-certified only)");
-  if (o.membership != defaults.membership && (o.accel.rfind("bsp", 0) != 0 || !o.tree.empty()))
+  if (o.membership != defaults.membership && !used.membership)
     ignored.push_back(o.tree.empty() ? "--membership (BSP accelerators only)"
                                      : "--membership (a BSP built in memory only; the tree file fixed it when it was "
                                        "built: bsprt build --membership)");
@@ -87,11 +99,10 @@ std::vector<std::string> ignored_options(const TraceOptions& o) {
 
 TraceOptions without_ignored_options(TraceOptions o) {
   const TraceOptions defaults;
-  for (const std::string& name : ignored_options(o)) {
-    if (name.rfind("--single-rays", 0) == 0) o.single_rays = defaults.single_rays;
-    if (name.rfind("--top-slots", 0) == 0) o.top_slots = defaults.top_slots;
-    if (name.rfind("--membership", 0) == 0) o.membership = defaults.membership;
-  }
+  const UsedOptions used = used_options(o);
+  if (!used.single_rays) o.single_rays = defaults.single_rays;
+  if (!used.top_slots) o.top_slots = defaults.top_slots;
+  if (!used.membership) o.membership = defaults.membership;
   return o;
 }
 
