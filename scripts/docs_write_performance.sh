@@ -60,7 +60,11 @@ threads=$(grep -o '"threads": [0-9]*' "$PERF/bench.json" | head -1 | grep -o '[0
 isa=$(grep -o '"isa": "[a-z0-9]*"' "$PERF/bench.json" | head -1 | cut -d'"' -f4)
 width=$(grep -o '"packet_width": [0-9]*' "$PERF/bench.json" | head -1 | grep -o '[0-9]*$')
 fit=$(cat "$PERF/scaling-fit.txt")
-commit=$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- . 2>/dev/null || echo " + uncommitted changes")
+# The run's own outputs (docs/perf, docs/gallery, this page) differ from HEAD by
+# now; only changes elsewhere mean the numbers came from uncommitted code.
+commit=$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- . ':!docs/perf' ':!docs/gallery' \
+  ':!docs/performance.md' 2>/dev/null && git ls-files --others --exclude-standard -- . ':!docs/perf' \
+  ':!docs/gallery' | (! grep -q .) || echo " + uncommitted changes")
 vcount=$(awk -F, 'NR == 2 { print $16 }' "$PERF/vertex-bunny.csv")
 
 cat <<EOF
