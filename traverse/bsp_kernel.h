@@ -60,13 +60,15 @@ struct BspView {
 /// Per-ray constants of the traversal, made once per ray by bsp_ray_setup.
 struct BspRayConst {
   float o[3];        ///< origin
-  float dir[3];      ///< direction
+  float dir[3];      ///< direction of the traversal: the ray's, or scaled into range (scale_direction)
   float inv[3];      ///< 1/dir_k; NaN when dir_k is subnormal or the ray is unsafe
   bool neg[3];       ///< sign bit of inv[k]: kd near child is the upper one
   float err;         ///< err_o + err_d·T: certified error of n·(o + t·dir) + d for every t of
                      ///< the clipped segment, T = max(|tmin|, |tmax|) (inf: unsafe ray)
   float tmin, tmax;  ///< ray segment clipped (conservatively) to the root cell
   bool live;         ///< valid ray with a non-empty clipped segment
+  bool scaled;       ///< traversal parameters are the ray's t times hit_scale (scale_direction)
+  float hit_scale;   ///< 2^e of scale_direction; 1 when not scaled
 };
 
 /// Single-ray trace used by kernels for lanes that leave a packet.
@@ -197,17 +199,73 @@ inline void ray_setup_core(const F (&o)[3], const F (&dir)[3], const Box3f& root
   err = err_o + err_d * (at0 > at1 ? at0 : at1);
 }
 
+/// A valid ray whose origin is in the safe range but whose direction is not
+/// (max|dir_k| above kSafeMax or below kSafeMinDir) would take the slow
+/// fallback at every node. o + t·d = o + t'·d' with d' = d·2^-e and
+/// t' = t·2^e, so the traversal may follow (o, d') over [tnear·2^e, tfar·2^e]
+/// instead, with 2^e <= max|dir_k| < 2^(e+1): the same points, a direction in
+/// [1, 2), a safe ray (docs/certified-epsilons.md §4). Done only when every
+/// scaled value is exact (scaling it back gives the original); otherwise
+/// nothing changes (an invalid ray is never scaled: NaN and inf fail the
+/// checks). Returns whether it scaled; `hit_scale` = 2^e. Scalar (libm's
+/// ldexpf, ilogbf), also used lane by lane by the packet setup, so lanes
+/// equal single rays.
+[[gnu::cold, gnu::noinline]] inline bool scale_direction(const float (&o)[3], float (&dir)[3], float& tnear,
+                                                         float& tfar, float& hit_scale) {
+  float mo = 0.0f, md = 0.0f;
+  for (int k = 0; k < 3; ++k) {
+    mo = std::fabs(o[k]) > mo ? std::fabs(o[k]) : mo;
+    md = std::fabs(dir[k]) > md ? std::fabs(dir[k]) : md;
+  }
+  if (!(mo <= kSafeMax) || !(md > 0.0f) || !(md <= std::numeric_limits<float>::max())) return false;
+  if (md <= kSafeMax && md >= kSafeMinDir) return false;  // already safe
+  const int e = __builtin_ilogbf(md);  // -149..127 when md is finite and non-zero
+  float d[3];
+  for (int k = 0; k < 3; ++k) {
+    d[k] = __builtin_ldexpf(dir[k], -e);
+    if (__builtin_ldexpf(d[k], e) != dir[k]) return false;  // a subnormal result rounded
+  }
+  const float t0 = __builtin_ldexpf(tnear, e), t1 = __builtin_ldexpf(tfar, e);
+  if (__builtin_ldexpf(t0, -e) != tnear || __builtin_ldexpf(t1, -e) != tfar) return false;
+  for (int k = 0; k < 3; ++k) dir[k] = d[k];
+  tnear = t0, tfar = t1;
+  hit_scale = __builtin_ldexpf(1.0f, e);
+  return true;
+}
+
+/// The traversal's bound for a hit at `hit_t` (the ray's own t): hit_t, or
+/// for a scaled ray hit_t·hit_scale widened up. The widening covers what the
+/// unscaled traversal's margins cover for hit_t itself, scaled: a relative
+/// error (widen_up's 2^-21) and an absolute one, 2^-150 in t for a subnormal
+/// hit_t, which is hit_scale·2^-150 in the traversal's parameter (added as
+/// hit_scale·2^-149; it underflows to 0 only when widen_up's 2^-126 already
+/// covers it) and 2^-150 for a subnormal product.
+template <typename F, typename M>
+inline F hit_bound(F hit_t, M scaled, F hit_scale) {
+  return scaled ? widen_up(hit_t * hit_scale) + hit_scale * 0x1p-149f : hit_t;
+}
+
 /// Per-ray constants of one ray (ray_setup_core); an invalid ray is not live.
 inline BspRayConst bsp_ray_setup(const Ray& ray, const Box3f& root, bool certified) {
   BspRayConst c{};
   c.tmin = ray.tnear;
   c.tmax = ray.tfar;
+  c.hit_scale = 1.0f;
   c.live = is_valid(ray);
   if (!c.live) return c;
   for (int k = 0; k < 3; ++k) c.o[k] = ray.org[k], c.dir[k] = ray.dir[k];
+  float md = 0.0f;
+  for (int k = 0; k < 3; ++k) md = gabs(c.dir[k]) > md ? gabs(c.dir[k]) : md;
+  if (__builtin_expect(!(md <= kSafeMax && md >= kSafeMinDir), 0))  // rare: out of line
+    c.scaled = scale_direction(c.o, c.dir, c.tmin, c.tmax, c.hit_scale);
   ray_setup_core(c.o, c.dir, root, certified, c.inv, c.neg, c.tmin, c.tmax, c.err);
   c.live = c.tmin <= c.tmax;
   return c;
+}
+
+/// The traversal's bound for the ray's nearest hit so far (hit_bound).
+inline float hit_bound(const BspRayConst& c, float hit_t) {
+  return __builtin_expect(c.scaled, 0) ? hit_bound<float, bool>(hit_t, true, c.hit_scale) : hit_t;
 }
 
 }  // namespace BSPRT_ISA_NAMESPACE

@@ -45,11 +45,14 @@ struct BspPacketEntry {
 template <int W>
 struct BspPacketRay {
   vfloat<W> o[3], dir[3], inv[3];
+  vfloat<W> tdir[3];  ///< direction of the traversal (dir, or scaled by detail::scale_direction)
   vmask<W> neg[3];
   vfloat<W> err;
   vfloat<W> tmin, tmax;
   vfloat<W> tnear, tfar;
   vmask<W> live;
+  vmask<W> scaled;      ///< lanes traversed in scaled parameters
+  vfloat<W> hit_scale;  ///< 2^e of those lanes, 1 elsewhere
 };
 
 template <int W>
@@ -63,14 +66,21 @@ inline std::uint64_t lanes(vmask<W> m) {
 template <int W>
 inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count) {
   BspPacketRay<W> p{};  // lanes past count: zero direction, so not valid
+  p.hit_scale = splat<W>(1.0f);
   for (int i = 0; i < count; ++i) {
     const Ray& ray = rays[i];
-    for (int k = 0; k < 3; ++k) p.o[k][i] = ray.org[k], p.dir[k][i] = ray.dir[k];
-    p.tmin[i] = ray.tnear, p.tmax[i] = ray.tfar;
+    float o[3], d[3], t0 = ray.tnear, t1 = ray.tfar, scale = 1.0f;
+    for (int k = 0; k < 3; ++k) o[k] = ray.org[k], d[k] = ray.dir[k];
+    p.tnear[i] = t0, p.tfar[i] = t1;
+    for (int k = 0; k < 3; ++k) p.o[k][i] = o[k], p.dir[k][i] = d[k];
+    // bsp_ray_setup's scalar code; an invalid lane is never live, so whether
+    // it was scaled does not matter.
+    if (detail::scale_direction(o, d, t0, t1, scale)) p.scaled[i] = -1, p.hit_scale[i] = scale;
+    for (int k = 0; k < 3; ++k) p.tdir[k][i] = d[k];
+    p.tmin[i] = t0, p.tmax[i] = t1;
   }
-  p.tnear = p.tmin, p.tfar = p.tmax;
-  const vmask<W> valid = valid_lanes<W>(p.o, p.dir, p.tmin, p.tmax);
-  detail::ray_setup_core(p.o, p.dir, v.bounds, v.certified, p.inv, p.neg, p.tmin, p.tmax, p.err);
+  const vmask<W> valid = valid_lanes<W>(p.o, p.dir, p.tnear, p.tfar);
+  detail::ray_setup_core(p.o, p.tdir, v.bounds, v.certified, p.inv, p.neg, p.tmin, p.tmax, p.err);
   p.live = valid & (p.tmin <= p.tmax);
   return p;
 }
@@ -96,7 +106,7 @@ template <int W>
 inline vmask<W> cut_node(const CompactBspSlot& n, const BspPacketRay<W>& r, vfloat<W>& near_hi,
                          vfloat<W>& far_lo) {
   if (n.is_plane()) {
-    const vfloat<W> b = detail::plane_cut<vfloat<W>>(&n, r.o, r.dir, r.err, near_hi, far_lo);
+    const vfloat<W> b = detail::plane_cut<vfloat<W>>(&n, r.o, r.tdir, r.err, near_hi, far_lo);
     return b < 0.0f;
   }
   const int k = n.axis();
@@ -175,14 +185,16 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
       }
       packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
     }
+    // Each lane's nearest hit in its traversal parameter (detail::hit_bound).
+    const vfloat<W> best = detail::hit_bound<vfloat<W>, vmask<W>>(hit.t, r.scaled, r.hit_scale);
     for (;;) {
       if (sp == 0) return;
       const BspPacketEntry<W>& e = stack[--sp];
       // Lanes with a real stack entry: skip past the nearest hit, clamp tmax.
-      active = e.active & ~(e.popped & (e.tmin > hit.t));
+      active = e.active & ~(e.popped & (e.tmin > best));
       if (none<W>(active)) continue;
       node = e.node, tmin = e.tmin;
-      tmax = (e.popped & (hit.t < e.tmax)) ? hit.t : e.tmax;
+      tmax = (e.popped & (best < e.tmax)) ? best : e.tmax;
       break;
     }
   }

@@ -81,6 +81,7 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
   StackEntry stack[kBspMaxDepth];
   int sp = 0;
   std::uint32_t node = root;
+  float best = detail::hit_bound(rc, hit.t);  // hit.t in the traversal's parameter; changes at leaves only
   for (;;) {
     const CompactBspSlot* n = &v.nodes[node];
     bool leaf = true;
@@ -113,14 +114,17 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       }
       n = &v.nodes[node];
     }
-    if (leaf) intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
+    if (leaf) {
+      intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
+      best = detail::hit_bound(rc, hit.t);
+    }
     for (;;) {
       if (sp == 0) return;
       const StackEntry& e = stack[--sp];
-      if (e.tmin > hit.t) continue;
+      if (e.tmin > best) continue;
       node = e.node;
       tmin = e.tmin;
-      tmax = e.tmax < hit.t ? e.tmax : hit.t;
+      tmax = e.tmax < best ? e.tmax : best;
       break;
     }
   }
@@ -174,10 +178,12 @@ inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayCons
   }
   static_assert(offsetof(BoxTopNode, hi) == 12 * sizeof(float));
   const float inf = std::numeric_limits<float>::infinity();
+  float best = detail::hit_bound(rc, hit.t);  // the nearest hit in the traversal's parameter; changes in subtrees only
   for (;;) {
     if ((cur.ref & BoxTopNode::kSubtree) != 0) {
       traverse_subtree<kCount>(v, rc, ray, wr, cur.ref & ~BoxTopNode::kSubtree, cur.tmin,
-                               cur.tmax < hit.t ? cur.tmax : hit.t, hit, nearest, c);
+                               cur.tmax < best ? cur.tmax : best, hit, nearest, c);
+      best = detail::hit_bound(rc, hit.t);
     } else {
       const BoxTopNode& n = nodes[cur.ref];
       if constexpr (kCount) ++c->box_node_visits;
@@ -189,7 +195,7 @@ inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayCons
         enter = e > enter ? e : enter;  // NaN crossings do not clip
         exit = x < exit ? x : exit;
       }
-      const float hi = cur.tmax < hit.t ? cur.tmax : hit.t;
+      const float hi = cur.tmax < best ? cur.tmax : best;
       enter = detail::widen_dn(enter);
       exit = detail::widen_up(exit);
       enter = enter > cur.tmin ? enter : simd::splat<4>(cur.tmin);
@@ -235,7 +241,7 @@ inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayCons
     for (;;) {
       if (sp == 0) return;
       cur = stack[--sp];
-      if (!(cur.tmin > hit.t)) break;
+      if (!(cur.tmin > best)) break;
     }
   }
 }
@@ -308,13 +314,14 @@ inline bool lane_step(const BspView& v, Lane& L) {
     NearestHit unused;  // float leaves only
     intersect_leaf<false>(v, *n, *L.ray, L.wr, L.hit, unused, nullptr);
   }
+  const float best = detail::hit_bound(L.rc, L.hit.t);
   for (;;) {
     if (L.sp == 0) return true;
     const StackEntry& e = L.stack[--L.sp];
-    if (e.tmin > L.hit.t) continue;
+    if (e.tmin > best) continue;
     L.node = e.node;
     L.tmin = e.tmin;
-    L.tmax = e.tmax < L.hit.t ? e.tmax : L.hit.t;
+    L.tmax = e.tmax < best ? e.tmax : best;
     L.pop = 0;
     return false;
   }
