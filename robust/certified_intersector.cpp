@@ -7,6 +7,8 @@
 #include <cmath>
 #include <optional>
 
+#include "robust/nearest_float.h"
+
 namespace bsprt {
 namespace {
 
@@ -56,19 +58,6 @@ std::optional<int> sign_of(const Interval& x) {
 bool meets(int su, int sv, int sw) {
   const bool neg = su < 0 || sv < 0 || sw < 0, pos = su > 0 || sv > 0 || sw > 0;
   return !(neg && pos) && (neg || pos);
-}
-
-/// The float nearest to a rational (mpq_get_d truncates, so check neighbours).
-float nearest_float(const Rational& q) {
-  const float f0 = float(CGAL::to_double(q));
-  float best = f0;
-  Rational err = CGAL::abs(Rational(double(f0)) - q);
-  for (float f : {std::nextafter(f0, -INFINITY), std::nextafter(f0, INFINITY)}) {
-    if (!std::isfinite(f)) continue;
-    const Rational e = CGAL::abs(Rational(double(f)) - q);
-    if (e < err) best = f, err = e;
-  }
-  return best;
 }
 
 /// A hit of one triangle: t as an enclosure (a point when exact), and the

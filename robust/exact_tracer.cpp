@@ -12,6 +12,8 @@
 #include <optional>
 #include <vector>
 
+#include "robust/nearest_float.h"
+
 namespace bsprt {
 namespace {
 
@@ -102,18 +104,6 @@ std::pair<float, float> barycentrics(const Epeck::Point_3& p, const Epeck::Point
   return {float(CGAL::to_double(u)), float(CGAL::to_double(v))};
 }
 
-/// The float nearest to the exact value x (ties to even do not matter here).
-float round_to_float(const FT& x) {
-  const float f0 = float(CGAL::to_double(x));
-  float best = f0;
-  FT best_err = CGAL::abs(FT(f0) - x);
-  for (float f : {std::nextafter(f0, -INFINITY), std::nextafter(f0, INFINITY)}) {
-    const FT err = CGAL::abs(FT(f) - x);
-    if (err < best_err) best = f, best_err = err;
-  }
-  return best;
-}
-
 }  // namespace
 
 struct ExactTracer::Impl {
@@ -187,7 +177,7 @@ Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
   if (!best_t) return best;
   const auto [a, b, c] = impl_->soup.corners(best_prim);
   const auto [u, v] = barycentrics(*best_p, to_epeck(a), to_epeck(b), to_epeck(c));
-  best.t = round_to_float(*best_t);
+  best.t = nearest_float(*best_t);
   best.prim = best_prim;
   best.u = u;
   best.v = v;

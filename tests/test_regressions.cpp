@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <fstream>
+#include <limits>
 #include <utility>
 
 #include "geometry/default_scene.h"
@@ -136,4 +137,33 @@ TEST_CASE("mesh loader: a PLY ending on its end_header line is an InputError", "
   std::string bin = head + "end_header";
   bin.replace(bin.find("ascii"), 5, "binary_little_endian");
   CHECK(load_error("end_header_eof_bin.ply", bin).first.find("truncated") != std::string::npos);
+}
+
+// Found by fuzz_differential (2026-12-01, a long local run): a ray with a
+// subnormal direction meets a triangle at an exact t beyond the float range.
+// The exact reference rounded it through float(to_double(t)) = inf and built
+// an exact number from that infinity: CGAL's assertion is_finite(d) fired
+// (sanitizer build); Release builds reported FLT_MAX, while the certified leaf
+// test reported infinity. Both now round with robust/nearest_float.h, as IEEE
+// does: from FLT_MAX + half an ulp on, infinity; below, a finite float.
+TEST_CASE("exact reference: a hit beyond the float range rounds to infinity", "[regression]") {
+  TriangleSoup s;
+  add_tri(s, {-1, -1, 1}, {3, -1, 1}, {-1, 3, 1});
+  add_tri(s, {-1, -1, 0x1p100f}, {3, -1, 0x1p100f}, {-1, 3, 0x1p100f});
+  const ExactTracer exact(s);
+  const CertifiedBruteTracer certified(s);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const Tracer* t : {static_cast<const Tracer*>(&exact), static_cast<const Tracer*>(&certified)}) {
+    // t = 1 / 1e-40, about 1e40: beyond every float.
+    Hit h;
+    REQUIRE_NOTHROW(h = t->trace(ray_of({0.25f, 0.25f, 0}, {0, 0, 1e-40f})));
+    CHECK(h.prim == 0);
+    CHECK(h.t == inf);
+    // t = 2^100 / 2^-27.5 is not a float; t = 2^100 / 2^-27 = 2^127 is, and stays finite.
+    REQUIRE_NOTHROW(h = t->trace(ray_of({0.25f, 0.25f, 2}, {0, 0, 0x1p-27f})));
+    CHECK(h.prim == 1);
+    CHECK(h.t == (0x1p100f - 2.0f) / 0x1p-27f);
+    // Behind the origin, the same magnitude: -infinity is below tnear = 0, so no hit.
+    CHECK(!t->trace(ray_of({0.25f, 0.25f, 0}, {0, 0, -1e-40f})).hit());
+  }
 }
