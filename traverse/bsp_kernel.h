@@ -245,6 +245,16 @@ inline F hit_bound(F hit_t, M scaled, F hit_scale) {
   return scaled ? widen_up(hit_t * hit_scale) + hit_scale * 0x1p-149f : hit_t;
 }
 
+/// scale_direction for a direction out of range; the common case, a direction
+/// in range, is decided inline.
+inline bool scale_if_out_of_range(const float (&o)[3], float (&dir)[3], float& tnear, float& tfar,
+                                  float& hit_scale) {
+  float md = 0.0f;
+  for (int k = 0; k < 3; ++k) md = gabs(dir[k]) > md ? gabs(dir[k]) : md;
+  if (__builtin_expect(md <= kSafeMax && md >= kSafeMinDir, 1)) return false;
+  return scale_direction(o, dir, tnear, tfar, hit_scale);
+}
+
 /// Per-ray constants of one ray (ray_setup_core); an invalid ray is not live.
 inline BspRayConst bsp_ray_setup(const Ray& ray, const Box3f& root, bool certified) {
   BspRayConst c{};
@@ -254,10 +264,7 @@ inline BspRayConst bsp_ray_setup(const Ray& ray, const Box3f& root, bool certifi
   c.live = is_valid(ray);
   if (!c.live) return c;
   for (int k = 0; k < 3; ++k) c.o[k] = ray.org[k], c.dir[k] = ray.dir[k];
-  float md = 0.0f;
-  for (int k = 0; k < 3; ++k) md = gabs(c.dir[k]) > md ? gabs(c.dir[k]) : md;
-  if (__builtin_expect(!(md <= kSafeMax && md >= kSafeMinDir), 0))  // rare: out of line
-    c.scaled = scale_direction(c.o, c.dir, c.tmin, c.tmax, c.hit_scale);
+  c.scaled = scale_if_out_of_range(c.o, c.dir, c.tmin, c.tmax, c.hit_scale);
   ray_setup_core(c.o, c.dir, root, certified, c.inv, c.neg, c.tmin, c.tmax, c.err);
   c.live = c.tmin <= c.tmax;
   return c;

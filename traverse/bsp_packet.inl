@@ -53,6 +53,7 @@ struct BspPacketRay {
   vmask<W> live;
   vmask<W> scaled;      ///< lanes traversed in scaled parameters
   vfloat<W> hit_scale;  ///< 2^e of those lanes, 1 elsewhere
+  bool any_scaled;      ///< some lane is scaled
 };
 
 template <int W>
@@ -66,18 +67,28 @@ inline std::uint64_t lanes(vmask<W> m) {
 template <int W>
 inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count) {
   BspPacketRay<W> p{};  // lanes past count: zero direction, so not valid
-  p.hit_scale = splat<W>(1.0f);
   for (int i = 0; i < count; ++i) {
     const Ray& ray = rays[i];
-    float o[3], d[3], t0 = ray.tnear, t1 = ray.tfar, scale = 1.0f;
-    for (int k = 0; k < 3; ++k) o[k] = ray.org[k], d[k] = ray.dir[k];
-    p.tnear[i] = t0, p.tfar[i] = t1;
-    for (int k = 0; k < 3; ++k) p.o[k][i] = o[k], p.dir[k][i] = d[k];
-    // bsp_ray_setup's scalar code; an invalid lane is never live, so whether
-    // it was scaled does not matter.
-    if (detail::scale_direction(o, d, t0, t1, scale)) p.scaled[i] = -1, p.hit_scale[i] = scale;
+    for (int k = 0; k < 3; ++k) p.o[k][i] = ray.org[k], p.dir[k][i] = ray.dir[k];
+    p.tmin[i] = ray.tnear, p.tmax[i] = ray.tfar;
+  }
+  p.tnear = p.tmin, p.tfar = p.tmax;
+  p.hit_scale = splat<W>(1.0f);
+  for (int k = 0; k < 3; ++k) p.tdir[k] = p.dir[k];
+  // A direction out of range (rare): bsp_ray_setup's scalar scale_direction,
+  // lane by lane. An invalid lane is never live, so whether it was scaled
+  // does not matter.
+  vfloat<W> md{};
+  for (int k = 0; k < 3; ++k) md = abs<W>(p.dir[k]) > md ? abs<W>(p.dir[k]) : md;
+  const unsigned out = movemask<W>(~((md <= detail::kSafeMax) & (md >= detail::kSafeMinDir)));
+  for (unsigned m = out & ((1u << count) - 1u); m != 0; m &= m - 1) {
+    const int i = __builtin_ctz(m);
+    float o[3], d[3], t0 = p.tnear[i], t1 = p.tfar[i], scale = 1.0f;
+    for (int k = 0; k < 3; ++k) o[k] = p.o[k][i], d[k] = p.dir[k][i];
+    if (!detail::scale_direction(o, d, t0, t1, scale)) continue;
     for (int k = 0; k < 3; ++k) p.tdir[k][i] = d[k];
-    p.tmin[i] = t0, p.tmax[i] = t1;
+    p.tmin[i] = t0, p.tmax[i] = t1, p.scaled[i] = -1, p.hit_scale[i] = scale;
+    p.any_scaled = true;
   }
   const vmask<W> valid = valid_lanes<W>(p.o, p.dir, p.tnear, p.tfar);
   detail::ray_setup_core(p.o, p.tdir, v.bounds, v.certified, p.inv, p.neg, p.tmin, p.tmax, p.err);
@@ -186,7 +197,8 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
       packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
     }
     // Each lane's nearest hit in its traversal parameter (detail::hit_bound).
-    const vfloat<W> best = detail::hit_bound<vfloat<W>, vmask<W>>(hit.t, r.scaled, r.hit_scale);
+    const vfloat<W> best =
+        r.any_scaled ? detail::hit_bound<vfloat<W>, vmask<W>>(hit.t, r.scaled, r.hit_scale) : hit.t;
     for (;;) {
       if (sp == 0) return;
       const BspPacketEntry<W>& e = stack[--sp];
