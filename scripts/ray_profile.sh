@@ -7,6 +7,7 @@
 # docs/certified-epsilons.md §13 quotes this table.
 #   scripts/ray_profile.sh                           # bunny, 100000 rays per set
 #   scripts/ray_profile.sh path/to/mesh.ply 50000    # another mesh, fewer rays
+#   MODES="kd bsp:interleaved" RAYSETS=random BSPRT_BUILD_DIR=dir BSPRT_SKIP_DEPS=1 scripts/ray_profile.sh
 # Run by hand (not in CI): about a minute per mode and ray set on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,7 +37,7 @@ trap 'rm -rf "$work"' EXIT
 "$BSPRT" build "$SCENE" --accel kd -o "$work/tree.kd" >/dev/null 2>&1
 "$BSPRT" build "$SCENE" --accel bsp -o "$work/tree.bsp" >/dev/null 2>&1
 for set in $RAYSETS; do
-  side=$(python3 -c "import math; print(max(1, round(math.sqrt($N))))")
+  side=$(awk -v n="$N" 'BEGIN { s = int(sqrt(n) + 0.5); print (s < 1 ? 1 : s) }')
   if [ "$set" = primary ]; then
     "$BSPRT" gen-rays "$SCENE" --kind primary --size "$side" "$side" -o "$work/$set.rays" >/dev/null 2>&1
     "$BSPRT" gen-rays "$SCENE" --kind primary --size 1 1 -o "$work/$set-1.rays" >/dev/null 2>&1
@@ -60,7 +61,7 @@ profile() {
 }
 # Events of a cachegrind file: Ir Bc Bcm (instructions, cond. branches, their mispredicts).
 events() { awk '/^events:/{for(i=2;i<=NF;i++) e[$i]=i} /^summary:/{print $e["Ir"], $e["Bc"], $e["Bcm"]}' "$1"; }
-count() { python3 -c "import struct,sys; print(struct.unpack('<Q', open(sys.argv[1],'rb').read()[8:16])[0])" "$1"; }
+count() { od -An -t u8 -j 8 -N 8 "$1" | tr -d ' '; }  # N of a .rays file (formats.md)
 
 echo "| rays | mode | instructions / ray | cond. branches / ray | mispredicts / ray |"
 echo "|---|---|---:|---:|---:|"

@@ -572,17 +572,25 @@ TEST_CASE("BSP: a direction scaled out of range by a power of two is traced at n
     plain.trace_batch(rays, single, 1, &cs);
     CHECK(cs.kd_node_visits + cs.bsp_node_visits <= 2 * base_visits);
     CHECK(cs.leaf_visits <= 2 * cb.leaf_visits);
-    // Packets and interleaved single rays make the same steps.
-    for (int w : {4, 8, 16}) {
-      if (int(detected_isa()) < int(isa_for_width(w))) continue;
-      RayCounters cp;
-      std::vector<Hit> packed(rays.size());
-      plain.trace_batch(rays, packed, w, &cp);
-      INFO("packets of " << w);
-      CHECK(std::memcmp(packed.data(), single.data(), rays.size() * sizeof(Hit)) == 0);
-      CHECK(cp.kd_node_visits == cs.kd_node_visits);
-      CHECK(cp.bsp_node_visits == cs.bsp_node_visits);
-      CHECK(cp.leaf_visits == cs.leaf_visits);
+    // Packets and interleaved single rays make the same steps: packets of
+    // scaled lanes only, and packets mixing scaled and ordinary lanes.
+    std::vector<Ray> mixed;
+    for (std::size_t i = 0; i < rays.size(); ++i) mixed.push_back(i % 3 == 0 ? base[i] : rays[i]);
+    for (const std::vector<Ray>* set : {&rays, &mixed}) {
+      RayCounters c1;
+      std::vector<Hit> one(set->size());
+      plain.trace_batch(*set, one, 1, &c1);
+      for (int w : {4, 8, 16}) {
+        if (int(detected_isa()) < int(isa_for_width(w))) continue;
+        RayCounters cp;
+        std::vector<Hit> packed(set->size());
+        plain.trace_batch(*set, packed, w, &cp);
+        INFO("packets of " << w << (set == &mixed ? ", mixed lanes" : ""));
+        CHECK(std::memcmp(packed.data(), one.data(), set->size() * sizeof(Hit)) == 0);
+        CHECK(cp.kd_node_visits == c1.kd_node_visits);
+        CHECK(cp.bsp_node_visits == c1.bsp_node_visits);
+        CHECK(cp.leaf_visits == c1.leaf_visits);
+      }
     }
     BspTracer interleaved(s.flat, s.soup);
     interleaved.set_single_rays(BspSingleRays::Interleaved);

@@ -204,7 +204,8 @@ inline void ray_setup_core(const F (&o)[3], const F (&dir)[3], const Box3f& root
 /// fallback at every node. o + t·d = o + t'·d' with d' = d·2^-e and
 /// t' = t·2^e, so the traversal may follow (o, d') over [tnear·2^e, tfar·2^e]
 /// instead, with 2^e <= max|dir_k| < 2^(e+1): the same points, a direction in
-/// [1, 2), a safe ray (docs/certified-epsilons.md §4). Done only when every
+/// [1, 2), a safe ray (docs/certified-epsilons.md §4). Callers decide the
+/// direction's range first (scale_if_out_of_range, the packet setup). Done only when every
 /// scaled value is exact (scaling it back gives the original); otherwise
 /// nothing changes (an invalid ray is never scaled: NaN and inf fail the
 /// checks). Returns whether it scaled; `hit_scale` = 2^e. Scalar (libm's
@@ -218,7 +219,6 @@ inline void ray_setup_core(const F (&o)[3], const F (&dir)[3], const Box3f& root
     md = std::fabs(dir[k]) > md ? std::fabs(dir[k]) : md;
   }
   if (!(mo <= kSafeMax) || !(md > 0.0f) || !(md <= std::numeric_limits<float>::max())) return false;
-  if (md <= kSafeMax && md >= kSafeMinDir) return false;  // already safe
   const int e = __builtin_ilogbf(md);  // -149..127 when md is finite and non-zero
   float d[3];
   for (int k = 0; k < 3; ++k) {
