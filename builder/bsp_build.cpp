@@ -55,6 +55,18 @@ class Builder {
   bool try_split(const Cell& cell, const std::vector<ClippedTriangle>& tris, const Candidate& c,
                  double area, SplitResult& out, ExactStats& st);
   void flush(const ExactStats& st, double done_weight);
+
+ public:
+  /// The last progress report is exactly (total, total): the leaves' weights are
+  /// fractions summed in whatever order the threads finish, so their float sum can
+  /// fall just short of the total (regression test "bsp: progress reaches the total").
+  void finish() {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (progress_ && reported_ < total_) progress_(total_, total_);
+    reported_ = total_;
+  }
+
+ private:
   /// The split beats the leaf by at least BspConfig::min_gain (area weighted).
   bool worth_it(double cost, std::size_t n, double area) const {
     const double leaf = cfg_.c_isect * double(n);
@@ -261,6 +273,7 @@ BspTree build_bsp(const TriangleSoup& soup, const BspConfig& config, BspBuildRep
   std::unique_ptr<BuildNode> root;
   tbb::task_arena arena(config.threads > 0 ? config.threads : tbb::task_arena::automatic);
   arena.execute([&] { root = builder.build(Cell::box(root_box), std::move(tris), 0, double(ids.size())); });
+  builder.finish();
   Flattener f;
   f.root_area = root->area;
   f.add(*root, 0);
