@@ -23,7 +23,7 @@
 #include "builder/bsp_flatten.h"
 #include "geometry/camera.h"
 #include "geometry/default_scene.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/load_mesh.h"
 #include "geometry/ray_gen.h"
 #include "robust/exact_tracer.h"
@@ -37,9 +37,9 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 /// Modes whose speed is measured on the error subset only (too slow for more).
-bool is_slow_mode(const std::string& mode) { return mode == "exact" || mode == "brute" || mode == "brute-certified"; }
+bool is_slow_mode(const std::string& mode) { return accel_info(mode).slow; }
 
-bool is_bsp_mode(const std::string& mode) { return mode.rfind("bsp", 0) == 0; }
+bool is_bsp_mode(const std::string& mode) { return accel_info(mode).tree == AccelTree::Bsp; }
 
 /// About n primary rays framing the scene, 4:3, in 8x8 tiles (ray_gen.h).
 std::vector<Ray> tiled_primary_rays(const TriangleSoup& soup, std::size_t n) {
@@ -90,57 +90,42 @@ std::vector<Ray> strided_subset(const std::vector<Ray>& rays, std::size_t n) {
 /// A built accelerator with its build time.
 struct BuiltMode {
   std::string mode;
-  std::unique_ptr<Tracer> tracer;
+  std::unique_ptr<Accelerator> tracer;
   double build_seconds = 0.0;
 };
 
 /// Builds the exact BSP tree once, flattens it and writes it to a temporary
 /// tree file, so every BSP mode loads the same tree. Returns build seconds.
-double build_bsp_once(const TriangleSoup& soup, int threads, const std::filesystem::path& file) {
+/// Builds the exact BSP and its flattening once (every BSP mode traces it), kept
+/// as an in-memory tree file; `seconds` receives the build time (without the file).
+std::shared_ptr<const TreeFileReader> build_bsp_once(const TriangleSoup& soup, int threads, double& seconds) {
   const auto t0 = Clock::now();
   BspConfig config;
   config.threads = threads;
   const BspTree exact = build_bsp(soup, config);
   const FlatBspTree flat = flatten_bsp(soup, exact);
-  const double seconds = seconds_since(t0);
-  write_bsp_file_with_flat(file.string(), soup, exact, flat);
-  return seconds;
-}
-
-std::filesystem::path temp_tree_path() {
-  std::random_device rd;
-  return std::filesystem::temp_directory_path() / fmt::format("bsprt-bench-{:016x}.tree",
-                                                              (std::uint64_t(rd()) << 32) ^ rd());
+  seconds = seconds_since(t0);
+  return std::make_shared<const TreeFileReader>("(bench: in-memory tree)", bsp_tree_file(soup, exact, flat).bytes());
 }
 
 /// Builds every mode for one scene (BSP modes share one build).
 std::vector<BuiltMode> build_modes(const BenchScene& scene, const BenchOptions& o, int threads,
                                    const std::function<void(const std::string&)>& step) {
   std::vector<BuiltMode> built;
-  std::filesystem::path tree_file;
+  std::shared_ptr<const TreeFileReader> bsp_tree;
   double bsp_seconds = 0.0;
-  struct Cleanup {
-    std::filesystem::path* p;
-    ~Cleanup() {
-      std::error_code ec;
-      if (!p->empty()) std::filesystem::remove(*p, ec);
-    }
-  } cleanup{&tree_file};
   for (const std::string& mode : o.modes) {
     step(fmt::format("{}: building {}", scene.name, mode));
     AccelOptions options;
     options.threads = threads;
     double seconds = 0.0;
     if (is_bsp_mode(mode)) {
-      if (tree_file.empty()) {
-        tree_file = temp_tree_path();
-        bsp_seconds = build_bsp_once(scene.soup, threads, tree_file);
-      }
-      options.tree_path = tree_file.string();
+      if (!bsp_tree) bsp_tree = build_bsp_once(scene.soup, threads, bsp_seconds);
+      options.tree_file = bsp_tree;
       seconds = bsp_seconds;
     }
     const auto t0 = Clock::now();
-    std::unique_ptr<Tracer> tracer = make_tracer(mode, scene.soup, options);
+    std::unique_ptr<Accelerator> tracer = make_tracer(mode, scene.soup, options);
     if (!is_bsp_mode(mode)) seconds = seconds_since(t0);
     built.push_back({mode, std::move(tracer), seconds});
   }
@@ -171,7 +156,7 @@ BenchRow measure_mode(const BuiltMode& m, const std::vector<Ray>& rays, const st
   row.mrays_single = double(timed.size()) / time_trace(*m.tracer, timed, hits, 1, runs) * 1e-6;
   row.hits = std::size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.hit(); }));
   // Certified modes and box tops trace packets as single rays: no packet row.
-  row.packet_width = bench_mode_is_certified(m.mode) || m.mode.rfind("bsp-top", 0) == 0 ? 1 : isa_width;
+  row.packet_width = accel_info(m.mode).packets ? isa_width : 1;
   if (row.packet_width > 1)
     row.mrays_packet = double(timed.size()) / time_trace(*m.tracer, timed, hits, row.packet_width, o.runs) * 1e-6;
   const RayCounters c = count_work(*m.tracer, subset.empty() ? timed : subset);
@@ -229,7 +214,7 @@ void check_options(const BenchOptions& o) {
 
 /// Traces all rays with `width`-wide packets over blocks of 1024 on all
 /// threads of the current arena; returns seconds of the fastest of `runs`.
-double time_trace(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int width,
+double time_trace(const Accelerator& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int width,
                   int runs) {
   hits.assign(rays.size(), Hit{});
   double best = 1e30;
@@ -246,7 +231,7 @@ double time_trace(const Tracer& tracer, const std::vector<Ray>& rays, std::vecto
 }
 
 /// Work per ray, counted in a separate single-ray pass (counters cost time).
-RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays) {
+RayCounters count_work(const Accelerator& tracer, const std::vector<Ray>& rays) {
   tbb::combinable<RayCounters> local;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& range) {
     for (std::size_t i = range.begin(); i < range.end(); ++i) tracer.trace(rays[i], &local.local());
@@ -256,9 +241,7 @@ RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays) {
   return sum;
 }
 
-bool bench_mode_is_certified(const std::string& mode) {
-  return mode == "bsp-certified" || mode == "bsp-top-certified" || mode == "exact" || mode == "brute-certified";
-}
+bool bench_mode_is_certified(const std::string& mode) { return accel_info(mode).certified; }
 
 double median_t_ulps(const std::vector<Hit>& reference, const std::vector<Hit>& tested) {
   std::vector<double> d;

@@ -15,12 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "geometry/hit_compare.h"
-#include "geometry/ray.h"
+#include "bsprt/compare.h"
+#include "bsprt/ray.h"
 #include "traverse/counters.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 #include "geometry/triangle_soup.h"
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 
 namespace bsprt {
 
@@ -94,10 +94,10 @@ BenchResult run_bench(const std::vector<BenchScene>& scenes, const BenchOptions&
 /// Traces all rays with `width`-wide packets over blocks of 1024 on all
 /// threads of the current arena; returns seconds of the fastest of `runs`.
 /// Shared by `bsprt bench` and bench/bench_kd.cpp.
-double time_trace(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int width, int runs);
+double time_trace(const Accelerator& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int width, int runs);
 
 /// Work per ray, counted in a separate single-ray pass (counters cost time).
-RayCounters count_work(const Tracer& tracer, const std::vector<Ray>& rays);
+RayCounters count_work(const Accelerator& tracer, const std::vector<Ray>& rays);
 
 /// True for modes traced only as single rays (their leaves decide exactly).
 bool bench_mode_is_certified(const std::string& mode);

@@ -6,7 +6,7 @@
 
 #include "apps/progress.h"
 #include "geometry/default_scene.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt::cli {
 
@@ -77,8 +77,8 @@ struct UsedOptions {
   bool single_rays, top_slots, membership;
 };
 UsedOptions used_options(const TraceOptions& o) {
-  return {o.accel == "bsp" || o.accel == "bsp-zero-eps", o.accel == "bsp-top" || o.accel == "bsp-top-certified",
-          o.accel.rfind("bsp", 0) == 0 && o.tree.empty()};
+  const AccelInfo& a = accel_info(o.accel);
+  return {a.uses_single_rays, a.uses_top_slots, a.tree == AccelTree::Bsp && o.tree.empty()};
 }
 }  // namespace
 
@@ -106,7 +106,7 @@ TraceOptions without_ignored_options(TraceOptions o) {
   return o;
 }
 
-std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& soup) {
+std::unique_ptr<Accelerator> make_accel(const TraceOptions& o, const TriangleSoup& soup) {
   const std::vector<std::string> ignored = ignored_options(o);
   if (!ignored.empty()) {
     std::string list;
@@ -121,7 +121,7 @@ std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& so
   options.single_rays = o.single_rays == "sequential"    ? BspSingleRays::Sequential
                         : o.single_rays == "interleaved" ? BspSingleRays::Interleaved
                                                          : BspSingleRays::Auto;
-  const bool building = o.tree.empty() && (o.accel == "kd" || o.accel.rfind("bsp", 0) == 0);
+  const bool building = o.tree.empty() && accel_info(o.accel).tree != AccelTree::None;
   std::unique_ptr<ProgressBar> bar;
   if (building && ProgressBar::stderr_is_terminal()) {
     bar = std::make_unique<ProgressBar>("building " + o.accel, 1000, "permille", true);

@@ -52,7 +52,7 @@ TraceOptions without_ignored_options(TraceOptions o);
 
 /// Builds or loads the accelerator named in `o`, with a progress bar on a
 /// terminal; throws UsageError when an option given is one `o.accel` ignores.
-std::unique_ptr<Tracer> make_accel(const TraceOptions& o, const TriangleSoup& soup);
+std::unique_ptr<Accelerator> make_accel(const TraceOptions& o, const TriangleSoup& soup);
 
 /// Registration of each subcommand (one file each).
 void register_trace(CLI::App& app);

@@ -13,7 +13,7 @@
 #include "apps/bench_runner.h"
 #include "apps/cli_common.h"
 #include "apps/progress.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt::cli {
 namespace {

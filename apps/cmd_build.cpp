@@ -14,7 +14,7 @@
 #include "builder/kd_build.h"
 #include "builder/kd_file.h"
 #include "builder/tree_file.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "traverse/bsp_node.h"
 
 namespace bsprt::cli {

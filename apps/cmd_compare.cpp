@@ -5,8 +5,8 @@
 #include <memory>
 
 #include "apps/cli_common.h"
-#include "geometry/hit_compare.h"
-#include "geometry/ray_io.h"
+#include "bsprt/compare.h"
+#include "bsprt/io.h"
 
 namespace bsprt::cli {
 namespace {

@@ -8,8 +8,8 @@
 #include <memory>
 
 #include "apps/cli_common.h"
-#include "geometry/error.h"
-#include "geometry/ray_io.h"
+#include "bsprt/error.h"
+#include "bsprt/io.h"
 #include "geometry/stiff_rays.h"
 #include "geometry/stiff_scenes.h"
 

@@ -7,7 +7,7 @@
 #include "apps/cli_common.h"
 #include "geometry/default_scene.h"
 #include "geometry/ray_gen.h"
-#include "geometry/ray_io.h"
+#include "bsprt/io.h"
 
 namespace bsprt::cli {
 namespace {

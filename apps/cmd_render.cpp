@@ -12,7 +12,7 @@
 #include "apps/progress.h"
 #include "apps/render.h"
 #include "geometry/default_scene.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt::cli {
 namespace {
@@ -49,7 +49,7 @@ void write_image(const std::string& path, const Image& image) {
 
 std::uint64_t tile_count(int w, int h) { return std::uint64_t((w + 15) / 16) * std::uint64_t((h + 15) / 16); }
 
-void run_cast(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& soup, RenderOptions options) {
+void run_cast(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup& soup, RenderOptions options) {
   RenderStats stats;
   Image image;
   {
@@ -68,7 +68,7 @@ void run_cast(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& sou
   }
 }
 
-void run_path(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& soup, const RenderOptions& base) {
+void run_path(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup& soup, const RenderOptions& base) {
   PathOptions options;
   options.width = base.width, options.height = base.height, options.camera = base.camera;
   options.spp = a.spp, options.bounces = a.bounces, options.seed = a.seed, options.packet_width = base.packet_width;
@@ -99,7 +99,7 @@ void run_path(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& sou
   if (!a.json.empty()) std::ofstream(a.json) << json;
 }
 
-void run_heat(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& soup, const RenderOptions& options) {
+void run_heat(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup& soup, const RenderOptions& options) {
   const HeatMetric metric = parse_heat_metric(a.heat_metric);
   const std::vector<float> cost = pixel_costs(tracer, options, metric);
   Image image;
@@ -107,7 +107,7 @@ void run_heat(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& sou
     TraceOptions other = a.trace;
     other.accel = a.heat_compare;
     other.tree.clear();
-    const std::unique_ptr<Tracer> b = make_accel(without_ignored_options(other), soup);
+    const std::unique_ptr<Accelerator> b = make_accel(without_ignored_options(other), soup);
     const std::vector<float> cost_b = pixel_costs(*b, options, metric);
     image = heat_difference_image(cost, cost_b, options.width, options.height,
                                   fmt::format("{} - {}\n{}", tracer.name(), b->name(), heat_metric_name(metric)));
@@ -125,7 +125,7 @@ void run_heat(const RenderArgs& a, const Tracer& tracer, const TriangleSoup& sou
 void run(const RenderArgs& a) {
   const auto threads = limit_threads(a.trace.threads);
   const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, true);
-  const std::unique_ptr<Tracer> tracer = make_accel(a.trace, soup);
+  const std::unique_ptr<Accelerator> tracer = make_accel(a.trace, soup);
   RenderOptions options;
   options.width = a.size[0];
   options.height = a.size[1];

@@ -14,8 +14,8 @@
 #include "builder/bsp_face_hits.h"
 #include "builder/bsp_file.h"
 #include "builder/tree_file.h"
-#include "geometry/error.h"
-#include "geometry/ray_io.h"
+#include "bsprt/error.h"
+#include "bsprt/io.h"
 #include "traverse/embree_tracer.h"
 
 namespace bsprt::cli {
@@ -54,7 +54,7 @@ FaceHitFigures count_face_hits(const TraceArgs& a, const TriangleSoup& soup, con
 }
 
 /// Traces all rays in parallel blocks; returns the summed counters.
-RayCounters trace_all(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits,
+RayCounters trace_all(const Accelerator& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits,
                       int packets, bool count) {
   tbb::combinable<RayCounters> counters;
   ProgressBar bar("tracing", rays.size(), "rays", ProgressBar::stderr_is_terminal() && rays.size() > (1u << 20));
@@ -73,12 +73,12 @@ void run(const TraceArgs& a) {
   if (a.face_hits) check_face_hits_usage(a);
   const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, !a.json);
   const std::vector<Ray> rays = read_rays(a.rays);
-  if (a.trace.accel.rfind("embree", 0) == 0)  // the file's own ray numbers, before the build
+  if (accel_info(a.trace.accel).embree_domain)  // the file's own ray numbers, before the build
     for (std::size_t i = 0; i < rays.size(); ++i)
       if (const char* why = embree_cannot_trace(rays[i]))
         throw UsageError(a.rays + ": ray " + std::to_string(i) + " has " + why + "; trace it with kd, bsp, brute or exact");
   const auto t0 = std::chrono::steady_clock::now();
-  const std::unique_ptr<Tracer> tracer = make_accel(a.trace, soup);
+  const std::unique_ptr<Accelerator> tracer = make_accel(a.trace, soup);
   const auto t1 = std::chrono::steady_clock::now();
   std::vector<Hit> hits(rays.size());
   const RayCounters c = trace_all(*tracer, rays, hits, a.trace.packets, a.stats);

@@ -70,7 +70,7 @@ void run(const VerifyArgs& a) {
   std::uint64_t leaves = 0;
   for (const VerifyNode& n : in.nodes) leaves += n.plane == VerifyNode::kLeaf;
   ProgressBar bar("verify", leaves, "leaves", ProgressBar::stderr_is_terminal());
-  VerifyOptions opt;
+  VerifyConfig opt;
   opt.threads = a.threads;
   opt.strict_extras = a.strict;
   opt.progress = [&bar](std::uint64_t done, std::uint64_t) { bar.set(done); };

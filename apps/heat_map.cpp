@@ -12,7 +12,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 namespace {
@@ -98,7 +98,7 @@ HeatMetric parse_heat_metric(const std::string& name) {
   throw UsageError("unknown heat metric '" + name + "' (expected time, nodes or tests)");
 }
 
-std::vector<float> pixel_costs(const Tracer& tracer, const RenderOptions& options, HeatMetric metric, int repeats) {
+std::vector<float> pixel_costs(const Accelerator& tracer, const RenderOptions& options, HeatMetric metric, int repeats) {
   const CameraRays camera(options.camera, options.width, options.height);
   std::vector<float> cost(std::size_t(options.width) * std::size_t(options.height), 0.0f);
   tbb::parallel_for(0, options.height, [&](int y) {

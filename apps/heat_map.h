@@ -10,7 +10,7 @@
 
 #include "apps/image_io.h"
 #include "apps/render.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
@@ -24,7 +24,7 @@ HeatMetric parse_heat_metric(const std::string& name);
 /// Cost of each pixel's primary ray (row-major): nanoseconds for Time (the
 /// median of `repeats` timings), node visits (kd + BSP) for Nodes, ray/triangle
 /// tests for Tests. Parallel over rows; counts are deterministic, times are not.
-std::vector<float> pixel_costs(const Tracer& tracer, const RenderOptions& options, HeatMetric metric, int repeats = 3);
+std::vector<float> pixel_costs(const Accelerator& tracer, const RenderOptions& options, HeatMetric metric, int repeats = 3);
 
 /// Colour-maps `cost` (0 .. scale_max; 0 = use the maximum) and appends a colour
 /// bar labelled with `title` and its scale.

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <fstream>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 #include <stb_image_write.h>
 

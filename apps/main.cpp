@@ -5,7 +5,7 @@
 #include <exception>
 
 #include "apps/cli_common.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"bsprt: ray tracing with general BSP trees, built exactly, traversed with certified epsilons"};

@@ -80,7 +80,7 @@ struct ThreadStats {
 };
 
 /// Traces `rays` into `hits` and books the time and count under `bounce`.
-void trace_timed(const Tracer& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int packet,
+void trace_timed(const Accelerator& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits, int packet,
                  ThreadStats& ts, int bounce) {
   hits.resize(rays.size());
   const auto t0 = std::chrono::steady_clock::now();
@@ -95,7 +95,7 @@ namespace {
 
 /// Everything one tile needs; paths are pixel-major, sample-minor.
 struct TileJob {
-  const Tracer& tracer;
+  const Accelerator& tracer;
   const TriangleSoup& soup;
   const PathOptions& opt;
   const CameraRays& camera;
@@ -201,7 +201,7 @@ void render_tile(const TileJob& job, int x0, int y0, int x1, int y1, Image& imag
 
 }  // namespace
 
-Image render_path(const Tracer& tracer, const TriangleSoup& soup, const PathOptions& options, PathStats* stats,
+Image render_path(const Accelerator& tracer, const TriangleSoup& soup, const PathOptions& options, PathStats* stats,
                   const RenderProgress& progress) {
   const auto start = std::chrono::steady_clock::now();
   Image image(options.width, options.height);

@@ -1,6 +1,6 @@
 #pragma once
 /// \file path_tracer.h
-/// A small path tracer over any Tracer: diffuse surfaces, a rectangular area
+/// A small path tracer over any Accelerator: diffuse surfaces, a rectangular area
 /// light with next-event estimation plus a sky, stratified pixel samples, and
 /// secondary rays spawned with pbrt-v4's error-bound offsets (ray_offset.h).
 /// Paths are traced as wavefronts per 16x16 tile, bounce by bounce, so each
@@ -15,7 +15,7 @@
 #include "apps/render.h"
 #include "geometry/camera.h"
 #include "geometry/triangle_soup.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
@@ -41,7 +41,7 @@ struct PathStats {
 };
 
 /// Path-traces the scene; `progress` gets (tiles done, tiles total).
-Image render_path(const Tracer& tracer, const TriangleSoup& soup, const PathOptions& options,
+Image render_path(const Accelerator& tracer, const TriangleSoup& soup, const PathOptions& options,
                   PathStats* stats = nullptr, const RenderProgress& progress = {});
 
 }  // namespace bsprt

@@ -12,8 +12,8 @@
 #include <cmath>
 #include <limits>
 
-#include "geometry/ray.h"
-#include "geometry/vec3.h"
+#include "bsprt/ray.h"
+#include "bsprt/vec3.h"
 
 namespace bsprt {
 

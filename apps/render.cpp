@@ -35,7 +35,7 @@ struct TileStats {
 
 }  // namespace
 
-Image render_cast(const Tracer& tracer, const TriangleSoup& soup, const RenderOptions& options,
+Image render_cast(const Accelerator& tracer, const TriangleSoup& soup, const RenderOptions& options,
                   RenderStats* stats, const RenderProgress& progress) {
   const auto start = std::chrono::steady_clock::now();
   Image image(options.width, options.height);

@@ -1,6 +1,6 @@
 #pragma once
 /// \file render.h
-/// Ray casting into an image over any Tracer: primary rays in 16x16 tiles,
+/// Ray casting into an image over any Accelerator: primary rays in 16x16 tiles,
 /// traced in parallel with oneTBB, packets when asked, eye-light shading.
 
 #include <cstdint>
@@ -10,7 +10,7 @@
 #include "geometry/camera.h"
 #include "geometry/triangle_soup.h"
 #include "traverse/counters.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
@@ -35,7 +35,7 @@ using RenderProgress = std::function<void(std::uint64_t, std::uint64_t)>;
 
 /// Ray-casts the scene with eye-light shading (|cos| between the face normal and
 /// the ray, so both sides are lit); misses get a sky gradient.
-Image render_cast(const Tracer& tracer, const TriangleSoup& soup, const RenderOptions& options,
+Image render_cast(const Accelerator& tracer, const TriangleSoup& soup, const RenderOptions& options,
                   RenderStats* stats = nullptr, const RenderProgress& progress = {});
 
 }  // namespace bsprt

@@ -11,7 +11,7 @@
 #include "builder/kd_build.h"
 #include "builder/tree_file.h"
 #include "builder/kd_file.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 #include "traverse/brute_force.h"
@@ -30,15 +30,22 @@ auto with_threads(int threads, F&& f) {
   return arena.execute(std::forward<F>(f));
 }
 
-std::unique_ptr<Tracer> make_kd(const TriangleSoup& soup, const AccelOptions& options) {
-  KdTree tree = options.tree_path.empty()
-                    ? with_threads(options.threads, [&] { return build_kd(soup); })
-                    : read_kd_tree(options.tree_path, soup);
+/// The tree file of `options` (in memory, or opened from tree_path), or null.
+std::shared_ptr<const TreeFileReader> tree_file_of(const AccelOptions& options) {
+  if (options.tree_file) return options.tree_file;
+  if (!options.tree_path.empty()) return std::make_shared<const TreeFileReader>(options.tree_path);
+  return nullptr;
+}
+
+std::unique_ptr<Accelerator> make_kd(const TriangleSoup& soup, const AccelOptions& options) {
+  const auto file = tree_file_of(options);
+  KdTree tree = file ? read_kd_tree(*file, soup)
+                     : with_threads(options.threads, [&] { return build_kd(soup); });
   return std::make_unique<KdTracer>(std::move(tree), soup);
 }
 
 /// A BSP tracer whose leaves use the exact-decision test (owns that test).
-class CertifiedBspTracer final : public Tracer {
+class CertifiedBspTracer final : public Accelerator {
  public:
   /// top_slots > 0: under a box top of subtrees of at most that many slots.
   CertifiedBspTracer(FlatBspTree flat, const TriangleSoup& soup, std::uint32_t top_slots = 0)
@@ -58,10 +65,10 @@ class CertifiedBspTracer final : public Tracer {
 /// The flat BSP tree: read from the file (its flat sections, or flattened from
 /// its exact sections), or built and flattened in memory.
 FlatBspTree load_or_build_bsp(const TriangleSoup& soup, const AccelOptions& options) {
-  if (!options.tree_path.empty()) {
-    const TreeFileReader file(options.tree_path);
+  if (const auto file_ptr = tree_file_of(options)) {
+    const TreeFileReader& file = *file_ptr;
     if (file.kind() != TreeKind::Bsp)
-      throw InputError(options.tree_path, "is a kd-tree file; --accel bsp needs a BSP tree (bsprt build --accel bsp)");
+      throw InputError(file.path(), "is a kd-tree file; --accel bsp needs a BSP tree (bsprt build --accel bsp)");
     file.check_scene(soup);
     if (has_flat_bsp_sections(file)) return read_flat_bsp_sections(file, soup);
     const BspTree exact = read_bsp_sections(file, soup);
@@ -70,7 +77,7 @@ FlatBspTree load_or_build_bsp(const TriangleSoup& soup, const AccelOptions& opti
     } catch (const std::logic_error& e) {  // UsageError and BspTree's own checks: a tree that reads but is
       // inconsistent (a plane that does not cut its cell, ...) is bad input, not a bug.
       // Regression test "tree file: a BSP plane that does not cut its cell is an InputError".
-      throw InputError(options.tree_path, std::string("is not a valid BSP tree for this scene: ") + e.what());
+      throw InputError(file.path(), std::string("is not a valid BSP tree for this scene: ") + e.what());
     }
   }
   BspConfig config = options.bsp;
@@ -79,41 +86,86 @@ FlatBspTree load_or_build_bsp(const TriangleSoup& soup, const AccelOptions& opti
   return flatten_bsp(soup, exact);
 }
 
+std::unique_ptr<Accelerator> make_bsp(const TriangleSoup& soup, const AccelOptions& options,
+                                      BspEpsilon eps) {
+  auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(soup, options), soup, eps);
+  bsp->set_single_rays(options.single_rays);
+  return bsp;
+}
+
+std::unique_ptr<Accelerator> make_embree(const TriangleSoup& soup, bool robust) {
+  EmbreeConfig c;
+  c.robust = robust;
+  return std::make_unique<EmbreeTracer>(soup, c);
+}
+
+using A = AccelTree;
+// name, what, tree, certified, packets, slow, embree_domain, single_rays, top_slots, make
+constexpr AccelInfo kTable[] = {
+    {"brute", "every triangle, float watertight test", A::None, false, true, true, false, false, false,
+     [](const TriangleSoup& s, const AccelOptions&) -> std::unique_ptr<Accelerator> {
+       return std::make_unique<BruteForceTracer>(s);
+     }},
+    {"brute-certified", "every triangle, exact-decision test", A::None, true, false, true, false, false, false,
+     [](const TriangleSoup& s, const AccelOptions&) -> std::unique_ptr<Accelerator> {
+       return std::make_unique<CertifiedBruteTracer>(s);
+     }},
+    {"exact", "the exact reference: CGAL AABB tree, exact predicates and parameters", A::None, true, false, true,
+     false, false, false,
+     [](const TriangleSoup& s, const AccelOptions&) -> std::unique_ptr<Accelerator> {
+       return std::make_unique<ExactTracer>(s);
+     }},
+    {"embree", "Embree 3, robust mode", A::None, false, true, false, true, false, false,
+     [](const TriangleSoup& s, const AccelOptions&) { return make_embree(s, true); }},
+    {"embree-fast", "Embree 3, default mode", A::None, false, true, false, true, false, false,
+     [](const TriangleSoup& s, const AccelOptions&) { return make_embree(s, false); }},
+    {"kd", "SAH kd-tree, float watertight leaf test", A::Kd, false, true, false, false, false, false, make_kd},
+    {"bsp", "exact BSP, certified float traversal, watertight leaf test", A::Bsp, false, true, false, false, true,
+     false, [](const TriangleSoup& s, const AccelOptions& o) { return make_bsp(s, o, BspEpsilon::Certified); }},
+    {"bsp-certified", "exact BSP, certified traversal, exact-decision leaf test", A::Bsp, true, false, false, false,
+     false, false,
+     [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
+       return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(s, o), s);
+     }},
+    {"bsp-zero-eps", "exact BSP traversed without the certified epsilons", A::Bsp, false, true, false, false, true,
+     false, [](const TriangleSoup& s, const AccelOptions& o) { return make_bsp(s, o, BspEpsilon::Zero); }},
+    {"bsp-top", "the BSP under a 4-wide box top, single rays", A::Bsp, false, false, false, false, false, true,
+     [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
+       auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(s, o), s, BspEpsilon::Certified);
+       add_box_top(*bsp, o.top_slots);
+       return bsp;
+     }},
+    {"bsp-top-certified", "bsp-top with the exact-decision leaf test", A::Bsp, true, false, false, false, false,
+     true,
+     [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
+       return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(s, o), s, o.top_slots);
+     }},
+};
+
 }  // namespace
 
-std::vector<std::string> accel_names() { return {"brute", "brute-certified", "exact", "embree", "embree-fast", "kd", "bsp", "bsp-certified", "bsp-zero-eps", "bsp-top", "bsp-top-certified"}; }
+std::span<const AccelInfo> accel_table() { return kTable; }
 
-std::unique_ptr<Tracer> make_tracer(const std::string& accel, const TriangleSoup& soup,
-                                    const AccelOptions& options) {
-  if (!options.tree_path.empty() && accel != "kd" && accel.rfind("bsp", 0) != 0)
-    throw UsageError("--tree works with --accel kd or bsp, not '" + accel + "'");
-  if (accel == "brute") return std::make_unique<BruteForceTracer>(soup);
-  if (accel == "exact") return std::make_unique<ExactTracer>(soup);
-  if (accel == "brute-certified") return std::make_unique<CertifiedBruteTracer>(soup);
-  if (accel == "embree") return std::make_unique<EmbreeTracer>(soup, EmbreeConfig{});
-  if (accel == "embree-fast") {
-    EmbreeConfig c;
-    c.robust = false;
-    return std::make_unique<EmbreeTracer>(soup, c);
-  }
-  if (accel == "kd") return make_kd(soup, options);
-  if (accel == "bsp" || accel == "bsp-zero-eps") {
-    auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(soup, options), soup,
-                                           accel == "bsp" ? BspEpsilon::Certified : BspEpsilon::Zero);
-    bsp->set_single_rays(options.single_rays);
-    return bsp;
-  }
-  if (accel == "bsp-top") {
-    auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(soup, options), soup, BspEpsilon::Certified);
-    add_box_top(*bsp, options.top_slots);
-    return bsp;
-  }
-  if (accel == "bsp-top-certified")
-    return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(soup, options), soup, options.top_slots);
-  if (accel == "bsp-certified") return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(soup, options), soup);
+const AccelInfo& accel_info(std::string_view name) {
+  for (const AccelInfo& a : kTable)
+    if (a.name == name) return a;
   std::string names;
-  for (const std::string& n : accel_names()) names += (names.empty() ? "" : ", ") + n;
-  throw UsageError("unknown accelerator '" + accel + "' (expected one of: " + names + ")");
+  for (const AccelInfo& a : kTable) names += (names.empty() ? "" : ", ") + std::string(a.name);
+  throw UsageError("unknown accelerator '" + std::string(name) + "' (expected one of: " + names + ")");
+}
+
+std::vector<std::string> accel_names() {
+  std::vector<std::string> names;
+  for (const AccelInfo& a : kTable) names.emplace_back(a.name);
+  return names;
+}
+
+std::unique_ptr<Accelerator> make_tracer(const std::string& accel, const TriangleSoup& soup,
+                                         const AccelOptions& options) {
+  const AccelInfo& info = accel_info(accel);
+  if (options.has_tree() && info.tree == AccelTree::None)
+    throw UsageError("--tree works with --accel kd or bsp, not '" + accel + "'");
+  return info.make(soup, options);
 }
 
 }  // namespace bsprt

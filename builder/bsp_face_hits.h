@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "builder/bsp_tree.h"
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "geometry/triangle_soup.h"
 #include "robust/plane.h"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "robust/exact_side.h"
 
 namespace bsprt {

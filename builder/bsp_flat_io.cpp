@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "builder/bsp_file.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 
@@ -55,14 +55,19 @@ FlatBspTree read_flat_bsp_sections(const TreeFileReader& r, const TriangleSoup& 
   return flat;
 }
 
-void write_bsp_file_with_flat(const std::string& path, const TriangleSoup& soup,
-                              const BspTree& exact, const FlatBspTree& flat,
-                              const BspReportRecord* report) {
+TreeFileWriter bsp_tree_file(const TriangleSoup& soup, const BspTree& exact, const FlatBspTree& flat,
+                             const BspReportRecord* report) {
   TreeFileWriter w(TreeKind::Bsp, soup);
   add_bsp_sections(w, exact);
   add_flat_bsp_sections(w, flat);
   if (report) w.add_section(kBspReportTag, std::as_bytes(std::span<const BspReportRecord>(report, 1)));
-  w.write(path);
+  return w;
+}
+
+void write_bsp_file_with_flat(const std::string& path, const TriangleSoup& soup,
+                              const BspTree& exact, const FlatBspTree& flat,
+                              const BspReportRecord* report) {
+  bsp_tree_file(soup, exact, flat, report).write(path);
 }
 
 }  // namespace bsprt

@@ -50,6 +50,11 @@ bool has_flat_bsp_sections(const TreeFileReader& r);
 /// missing, of another layout version or scene, or fail FlatBspTree::validate().
 FlatBspTree read_flat_bsp_sections(const TreeFileReader& r, const TriangleSoup& soup);
 
+/// The complete BSP tree file (exact sections, flattening, optional BRPT), ready
+/// to write or to keep in memory.
+TreeFileWriter bsp_tree_file(const TriangleSoup& soup, const BspTree& exact, const FlatBspTree& flat,
+                             const BspReportRecord* report = nullptr);
+
 /// Writes a complete BSP tree file: the exact tree's sections and its flattening.
 /// With `report`, the build figures go along in an optional BRPT section.
 void write_bsp_file_with_flat(const std::string& path, const TriangleSoup& soup,

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "robust/exact_side.h"
 
 namespace bsprt {
@@ -175,16 +175,6 @@ FlatBspTree flatten_bsp(const TriangleSoup& soup, const BspTree& exact, FlattenR
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   return flat;
-}
-
-std::unique_ptr<Tracer> make_bsp_tracer(const TriangleSoup& soup, const BspTree& exact,
-                                        BspEpsilon mode, FlattenReport* report) {
-  return std::make_unique<BspTracer>(flatten_bsp(soup, exact, report), soup, mode);
-}
-
-std::unique_ptr<Tracer> make_bsp_tracer(const TriangleSoup& soup, FlatBspTree flat,
-                                        BspEpsilon mode) {
-  return std::make_unique<BspTracer>(std::move(flat), soup, mode);
 }
 
 }  // namespace bsprt

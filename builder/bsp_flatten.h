@@ -21,7 +21,7 @@
 #include "robust/epsilon_bound.h"
 #include "traverse/bsp_node.h"
 #include "traverse/bsp_traverse.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
@@ -50,15 +50,5 @@ FlatBspTree flatten_bsp(const TriangleSoup& soup, const BspTree& exact,
 /// `plane` splitting `cell` (exposed so tests can check the bound against
 /// exact evaluation at points of the cell).
 FloatPlane flat_plane_of(const TriangleSoup& soup, PlaneDef plane, const Cell& cell);
-
-/// A BspTracer over `soup` (which must outlive nothing: the tracer copies the
-/// triangles) from the exact tree: flatten_bsp, then BspTracer.
-std::unique_ptr<Tracer> make_bsp_tracer(const TriangleSoup& soup, const BspTree& exact,
-                                        BspEpsilon mode = BspEpsilon::Certified,
-                                        FlattenReport* report = nullptr);
-
-/// A BspTracer from an already flattened tree (e.g. read from a tree file).
-std::unique_ptr<Tracer> make_bsp_tracer(const TriangleSoup& soup, FlatBspTree flat,
-                                        BspEpsilon mode = BspEpsilon::Certified);
 
 }  // namespace bsprt

@@ -12,7 +12,7 @@
 #include <oneapi/tbb/task_group.h>
 
 #include "builder/kd_events.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "traverse/kd_traverse.h"
 
 namespace bsprt {

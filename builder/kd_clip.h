@@ -7,7 +7,7 @@
 
 #include <array>
 
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 
 namespace bsprt {
 

@@ -39,6 +39,10 @@ T single(const TreeFileReader& r, std::uint32_t tag) {
 
 void write_kd_tree(const std::string& path, const KdTree& tree, const TriangleSoup& soup,
                    const KdConfig& config) {
+  kd_tree_file(tree, soup, config).write(path);
+}
+
+TreeFileWriter kd_tree_file(const KdTree& tree, const TriangleSoup& soup, const KdConfig& config) {
   TreeFileWriter w(TreeKind::Kd, soup);
   w.add_array(kKdNodesTag, tree.nodes);
   w.add_array(kKdPrimsTag, tree.prims);
@@ -49,11 +53,15 @@ void write_kd_tree(const std::string& path, const KdTree& tree, const TriangleSo
                        config.max_depth, config.leaf_size, config.parallel_threshold,
                        config.perfect_splits ? 1u : 0u, 0u};
   w.add_array(kKdConfigTag, std::vector<ConfigRecord>{c});
-  w.write(path);
+  return w;
 }
 
 KdTree read_kd_tree(const std::string& path, const TriangleSoup& soup, KdConfig* config) {
-  const TreeFileReader r(path);
+  return read_kd_tree(TreeFileReader(path), soup, config);
+}
+
+KdTree read_kd_tree(const TreeFileReader& r, const TriangleSoup& soup, KdConfig* config) {
+  const std::string& path = r.path();
   if (r.kind() != TreeKind::Kd) throw InputError(path, "not a kd tree file (it holds another tree kind)");
   r.check_scene(soup);
   KdTree tree;

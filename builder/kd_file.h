@@ -27,4 +27,10 @@ void write_kd_tree(const std::string& path, const KdTree& tree, const TriangleSo
 /// holds a tree that fails KdTree::validate() or is too deep to traverse.
 KdTree read_kd_tree(const std::string& path, const TriangleSoup& soup, KdConfig* config = nullptr);
 
+/// read_kd_tree on a file already opened (or held in memory).
+KdTree read_kd_tree(const TreeFileReader& file, const TriangleSoup& soup, KdConfig* config = nullptr);
+
+/// The complete kd tree file of `tree`, ready to write or to keep in memory.
+TreeFileWriter kd_tree_file(const KdTree& tree, const TriangleSoup& soup, const KdConfig& config = {});
+
 }  // namespace bsprt

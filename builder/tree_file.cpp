@@ -90,7 +90,7 @@ void TreeFileWriter::add_section(std::uint32_t tag, std::span<const std::byte> b
   sections_[tag].assign(bytes.begin(), bytes.end());
 }
 
-void TreeFileWriter::write(const std::string& path) const {
+std::vector<std::byte> TreeFileWriter::bytes() const {
   std::vector<std::byte> out;
   out.insert(out.end(), reinterpret_cast<const std::byte*>(kMagic),
              reinterpret_cast<const std::byte*>(kMagic) + 8);
@@ -109,6 +109,11 @@ void TreeFileWriter::write(const std::string& path) const {
   }
   const std::uint32_t crc = crc32(out.data() + kCrcStart, out.size() - kCrcStart);
   std::memcpy(out.data() + 36, &crc, 4);
+  return out;
+}
+
+void TreeFileWriter::write(const std::string& path) const {
+  const std::vector<std::byte> out = bytes();
   std::ofstream f(path, std::ios::binary | std::ios::trunc);
   if (!f) throw InputError(path, "cannot create tree file");
   f.write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()));
@@ -116,8 +121,9 @@ void TreeFileWriter::write(const std::string& path) const {
   if (!f) throw InputError(path, "cannot write tree file");
 }
 
-TreeFileReader::TreeFileReader(const std::string& path) : path_(path) {
-  const std::vector<std::byte> in = read_all(path);
+TreeFileReader::TreeFileReader(const std::string& path) : TreeFileReader(path, read_all(path)) {}
+
+TreeFileReader::TreeFileReader(const std::string& path, const std::vector<std::byte>& in) : path_(path) {
   if (in.size() < kHeaderSize)
     throw InputError(path, "truncated tree file: " + std::to_string(in.size()) + " bytes, header needs 40");
   if (std::memcmp(in.data(), kMagic, 8) != 0) throw InputError(path, "not a bsprt tree file (bad magic)");

@@ -24,7 +24,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
+#include "bsprt/tree_kind.h"
 #include "geometry/triangle_soup.h"
 
 namespace bsprt {
@@ -39,8 +40,6 @@ constexpr std::uint32_t tree_tag(const char (&s)[5]) {
 /// The four characters of a tag, for messages.
 std::string tree_tag_name(std::uint32_t tag);
 
-/// What a tree file holds.
-enum class TreeKind : std::uint32_t { Kd = 1, Bsp = 2 };
 
 /// A 64-bit fingerprint of the triangle data (vertex coordinates of every
 /// triangle's corners, in triangle order); equal soups give equal fingerprints.
@@ -56,6 +55,8 @@ class TreeFileWriter {
   void add_array(std::uint32_t tag, const std::vector<T>& v) {
     add_section(tag, std::as_bytes(std::span<const T>(v)));
   }
+  /// The whole file image (header, sections, CRC), as `write` puts it on disk.
+  std::vector<std::byte> bytes() const;
   /// Writes the file; throws InputError when it cannot be written.
   void write(const std::string& path) const;
 
@@ -71,6 +72,9 @@ class TreeFileWriter {
 class TreeFileReader {
  public:
   explicit TreeFileReader(const std::string& path);
+  /// Checks a file image held in memory (TreeFileWriter::bytes); `path` names
+  /// it in messages.
+  TreeFileReader(const std::string& path, const std::vector<std::byte>& image);
   TreeKind kind() const { return kind_; }
   /// Triangle count of the scene the tree was built for.
   std::uint64_t triangle_count() const { return triangle_count_; }

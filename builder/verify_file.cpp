@@ -4,7 +4,7 @@
 
 #include "builder/bsp_file.h"
 #include "builder/bsp_flat_io.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 

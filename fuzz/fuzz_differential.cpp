@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "builder/accel_factory.h"
-#include "geometry/hit_compare.h"
+#include "bsprt/compare.h"
 #include "robust/degenerate.h"
 #include "traverse/bsp_traverse.h"
 #include "traverse/cpu_features.h"
@@ -93,7 +93,7 @@ std::vector<bsprt::Ray> make_rays(Reader& in, const bsprt::TriangleSoup& s) {
   return rays;
 }
 
-std::unique_ptr<bsprt::Tracer> make(const std::string& accel, const bsprt::TriangleSoup& s,
+std::unique_ptr<bsprt::Accelerator> make(const std::string& accel, const bsprt::TriangleSoup& s,
                                      std::uint32_t top_slots = 1024) {
   bsprt::AccelOptions o;
   o.threads = 1;
@@ -101,7 +101,7 @@ std::unique_ptr<bsprt::Tracer> make(const std::string& accel, const bsprt::Trian
   return bsprt::make_tracer(accel, s, o);
 }
 
-std::vector<bsprt::Hit> trace(const bsprt::Tracer& t, std::span<const bsprt::Ray> rays) {
+std::vector<bsprt::Hit> trace(const bsprt::Accelerator& t, std::span<const bsprt::Ray> rays) {
   std::vector<bsprt::Hit> hits;
   for (const bsprt::Ray& r : rays) hits.push_back(t.trace(r));
   return hits;
@@ -118,7 +118,7 @@ void expect_agree(const char* what, std::span<const bsprt::Hit> ref, std::span<c
 
 /// Packets of every width this CPU runs equal the same tracer's single rays bit
 /// for bit, hits and counters.
-void expect_packets_equal(const char* accel, const bsprt::Tracer& t, std::span<const bsprt::Ray> rays) {
+void expect_packets_equal(const char* accel, const bsprt::Accelerator& t, std::span<const bsprt::Ray> rays) {
   std::vector<bsprt::Hit> single(rays.size());
   bsprt::RayCounters cs;
   t.trace_batch(rays, single, 1, &cs);
@@ -142,7 +142,7 @@ void expect_packets_equal(const char* accel, const bsprt::Tracer& t, std::span<c
 }
 
 /// The interleaved single-ray kernel equals the sequential one bit for bit.
-void expect_interleaved_equal(bsprt::Tracer& t, std::span<const bsprt::Ray> rays) {
+void expect_interleaved_equal(bsprt::Accelerator& t, std::span<const bsprt::Ray> rays) {
   auto& bsp = dynamic_cast<bsprt::BspTracer&>(t);
   std::vector<bsprt::Hit> seq(rays.size()), inter(rays.size());
   bsp.set_single_rays(bsprt::BspSingleRays::Sequential);

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
-#include "geometry/error.h"
-#include "geometry/ray_io.h"
+#include "bsprt/error.h"
+#include "bsprt/io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = "/tmp/bsprt_fuzz_rays_" + std::to_string(getpid());

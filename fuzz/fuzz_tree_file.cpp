@@ -23,7 +23,7 @@
 #include "builder/kd_file.h"
 #include "builder/tree_file.h"
 #include "geometry/default_scene.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/ray_gen.h"
 
 namespace {
@@ -52,7 +52,7 @@ void try_accel(const std::string& accel, const std::string& path) {
   bsprt::AccelOptions o;
   o.tree_path = path;
   o.threads = 1;
-  std::unique_ptr<bsprt::Tracer> t;
+  std::unique_ptr<bsprt::Accelerator> t;
   try {
     t = bsprt::make_tracer(accel, scene(), o);
   } catch (const bsprt::InputError&) {

@@ -3,8 +3,8 @@
 /// A pinhole camera with Embree-tutorial parameters (--vp, --vi, --vu, --fov),
 /// and primary-ray generation shared by the renderer and `bsprt gen-rays`.
 
-#include "geometry/ray.h"
-#include "geometry/vec3.h"
+#include "bsprt/ray.h"
+#include "bsprt/vec3.h"
 
 namespace bsprt {
 

@@ -1,11 +1,11 @@
-#include "geometry/hit_compare.h"
+#include "bsprt/compare.h"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <string>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 

@@ -43,7 +43,7 @@
 #include <sstream>
 #include <cstring>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/mesh_scan.h"
 #include "geometry/openmesh_import.h"
 #include "robust/degenerate.h"

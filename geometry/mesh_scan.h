@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 
 namespace bsprt::detail {
 

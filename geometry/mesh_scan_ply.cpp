@@ -8,7 +8,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/mesh_scan.h"
 #include "geometry/mesh_scan_util.h"
 

@@ -11,7 +11,7 @@
 #include <cstring>
 #include <limits>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/mesh_scan.h"
 #include "geometry/mesh_scan_util.h"
 

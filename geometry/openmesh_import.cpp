@@ -13,7 +13,7 @@
 #include <mutex>
 #include <sstream>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt::detail {
 namespace {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 
 namespace bsprt::detail {
 

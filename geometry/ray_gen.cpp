@@ -5,7 +5,7 @@
 #include <numbers>
 #include <random>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 namespace {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "geometry/camera.h"
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "geometry/triangle_soup.h"
 
 namespace bsprt {

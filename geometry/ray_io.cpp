@@ -4,7 +4,7 @@
 /// Hit are byte-compatible with the records, so records are read and written
 /// in one block. N is checked against the file size before anything is
 /// allocated, so garbage never causes a huge allocation.
-#include "geometry/ray_io.h"
+#include "bsprt/io.h"
 
 #include <bit>
 #include <cstdint>
@@ -13,7 +13,7 @@
 #include <fstream>
 #include <string>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/ray_gen.h"
 
 namespace bsprt {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "geometry/triangle_soup.h"
 
 namespace bsprt {

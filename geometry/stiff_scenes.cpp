@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "geometry/default_scene.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "robust/degenerate.h"
 
 namespace bsprt {

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 

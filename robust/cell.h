@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "geometry/triangle_soup.h"
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 #include "robust/exact_side.h"
 #include "robust/plane.h"
 

@@ -19,7 +19,7 @@
 
 #include "geometry/triangle_soup.h"
 #include "traverse/leaf_intersector.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
@@ -42,7 +42,7 @@ class CertifiedIntersector final : public LeafIntersector {
 
 /// Brute force with the certified test: every triangle, exact decisions. The
 /// float structure-free reference that the certified tree tracers must equal.
-class CertifiedBruteTracer final : public Tracer {
+class CertifiedBruteTracer final : public Accelerator {
  public:
   explicit CertifiedBruteTracer(const TriangleSoup& soup);
   std::string name() const override { return "brute-certified"; }

@@ -17,7 +17,7 @@
 #include <limits>
 
 #include "geometry/triangle_soup.h"
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 #include "robust/plane.h"
 
 namespace bsprt {

@@ -11,14 +11,14 @@
 #include <memory>
 
 #include "geometry/triangle_soup.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
 /// Exact nearest-hit oracle. A ray lying in a triangle's plane and crossing it
 /// hits it at the nearest point of the overlap. Ties in exact t (a shared edge
 /// or vertex) go to the lowest triangle number. Degenerate triangles never hit.
-class ExactTracer final : public Tracer {
+class ExactTracer final : public Accelerator {
  public:
   /// Holds a reference: `soup` must outlive the tracer.
   explicit ExactTracer(const TriangleSoup& soup);

@@ -21,7 +21,7 @@
 #include <cstring>
 
 #include "geometry/triangle_soup.h"
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 
 namespace bsprt {
 

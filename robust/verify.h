@@ -56,7 +56,7 @@ struct VerifyInput {
 };
 
 /// Options of verify_bsp.
-struct VerifyOptions {
+struct VerifyConfig {
   int threads = 0;  ///< worker threads; 0 = all cores
   /// Spawn a parallel task for a subtree holding at least this many pieces.
   std::size_t parallel_min_pieces = 256;
@@ -108,6 +108,6 @@ struct VerifyReport {
 
 /// Verifies a BSP tree file's contents against `soup`. Never throws for a bad
 /// tree: the report carries the first counter-example.
-VerifyReport verify_bsp(const TriangleSoup& soup, const VerifyInput& in, const VerifyOptions& options = {});
+VerifyReport verify_bsp(const TriangleSoup& soup, const VerifyInput& in, const VerifyConfig& options = {});
 
 }  // namespace bsprt

@@ -32,7 +32,7 @@ struct Local {
 struct Walk {
   const TriangleSoup& soup;
   const VerifyInput& in;
-  const VerifyOptions& opt;
+  const VerifyConfig& opt;
   const Structure& st;
   const PlaneTable& pt;
   FailureSink& sink;
@@ -257,7 +257,7 @@ void Walk::run(std::uint32_t node, std::uint32_t flat, VCell cell, std::vector<P
 }  // namespace
 }  // namespace vfy
 
-VerifyReport verify_bsp(const TriangleSoup& soup, const VerifyInput& in, const VerifyOptions& opt) {
+VerifyReport verify_bsp(const TriangleSoup& soup, const VerifyInput& in, const VerifyConfig& opt) {
   using namespace vfy;
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<tbb::global_control> cap;

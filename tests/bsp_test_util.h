@@ -13,7 +13,7 @@
 
 #include "builder/bsp_build.h"
 #include "builder/bsp_flatten.h"
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "geometry/triangle_soup.h"
 #include "robust/degenerate.h"
 #include "traverse/brute_force.h"
@@ -75,7 +75,7 @@ inline std::string describe(const Ray& r, const Hit& a, const Hit& b) {
 /// Traces every ray with `tracer` and brute force and classifies the pairs
 /// (shared/formats.md "Comparing two hit files"). A tie is a different
 /// triangle at t within 1e-5 relative (shared edges and vertices).
-inline Comparison compare_with_brute(const TriangleSoup& soup, const Tracer& tracer,
+inline Comparison compare_with_brute(const TriangleSoup& soup, const Accelerator& tracer,
                                      std::span<const Ray> rays) {
   const BruteForceTracer bf(soup);
   Comparison c;

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/load_mesh.h"
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "geometry/triangle_soup.h"
 #include "test_util.h"
 #include "traverse/brute_force.h"

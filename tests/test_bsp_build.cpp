@@ -24,7 +24,7 @@
 #include "builder/bsp_build.h"
 #include "builder/bsp_candidates.h"
 #include "builder/bsp_file.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/load_mesh.h"
 #include "test_util.h"
 

@@ -22,7 +22,7 @@
 #include "builder/bsp_flat_io.h"
 #include "builder/kd_build.h"
 #include "geometry/default_scene.h"
-#include "geometry/hit_compare.h"
+#include "bsprt/compare.h"
 #include "geometry/load_mesh.h"
 #include "geometry/ray_gen.h"
 #include "test_util.h"
@@ -547,8 +547,8 @@ TEST_CASE("BSP: a direction scaled out of range by a power of two is traced at n
   plain.trace_batch(base, hb, 1, &cb);
   const std::uint64_t base_visits = cb.kd_node_visits + cb.bsp_node_visits;
   REQUIRE(base_visits > 0);
-  const std::unique_ptr<Tracer> exact = make_tracer("exact", soup);
-  const std::unique_ptr<Tracer> certified = make_tracer("bsp-certified", soup);
+  const std::unique_ptr<Accelerator> exact = make_tracer("exact", soup);
+  const std::unique_ptr<Accelerator> certified = make_tracer("bsp-certified", soup);
   for (const float scale : {0x1p70f, 0x1p-70f, 0x1p100f, 0x1p-100f, 0x1p65f, 0x1p-65f}) {
     std::vector<Ray> rays = base;
     for (Ray& r : rays) {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "geometry/hit_compare.h"
-#include "geometry/ray_io.h"
+#include "bsprt/compare.h"
+#include "bsprt/io.h"
 #include "test_util.h"
 
 using namespace bsprt;

@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "geometry/default_scene.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/ray_gen.h"
 
 using namespace bsprt;

@@ -58,7 +58,7 @@ TEST_CASE("exact tracer: hand-built answers", "[exact]") {
   Ray r;
   r.org = {0.25f, 0.25f, -2.0f};
   r.dir = {0, 0, 0.5f};
-  for (const Tracer* t : {static_cast<const Tracer*>(&exact), static_cast<const Tracer*>(&certified)}) {
+  for (const Accelerator* t : {static_cast<const Accelerator*>(&exact), static_cast<const Accelerator*>(&certified)}) {
     const Hit h = t->trace(r);
     CHECK(h.prim == 0);
     CHECK(h.t == 4.0f);

@@ -17,7 +17,7 @@
 #include "builder/accel_factory.h"
 #include "builder/kd_build.h"
 #include "builder/kd_file.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/load_mesh.h"
 #include "geometry/ray_gen.h"
 #include "robust/degenerate.h"

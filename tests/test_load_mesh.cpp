@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/load_mesh.h"
 #include "robust/degenerate.h"
 #include "test_util.h"

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "geometry/error.h"
-#include "geometry/ray_io.h"
+#include "bsprt/error.h"
+#include "bsprt/io.h"
 #include "test_util.h"
 
 using namespace bsprt;

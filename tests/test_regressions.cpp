@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "geometry/default_scene.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/load_mesh.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
@@ -76,7 +76,7 @@ TEST_CASE("exact reference: a direction tiny against the origin is traced", "[re
   const ExactTracer exact(s);
   const CertifiedBruteTracer certified(s);
   const Ray r = ray_of({0.25f, 0.25f, -1.0f}, {0, 0, 0x1p-100f});  // -1 + 2^-100 rounds to -1 in double
-  for (const Tracer* t : {static_cast<const Tracer*>(&exact), static_cast<const Tracer*>(&certified)}) {
+  for (const Accelerator* t : {static_cast<const Accelerator*>(&exact), static_cast<const Accelerator*>(&certified)}) {
     Hit h;
     REQUIRE_NOTHROW(h = t->trace(r));
     CHECK(h.prim == 0);
@@ -99,7 +99,7 @@ TEST_CASE("exact reference: candidates come from the exact ray when o + d rounds
   // At t = 2^40 the ray is at (2^40, 1 + 2^-23, 0), the edge's midpoint; in
   // double, 1 + 2^-63 rounds to 1.
   const Ray r = ray_of({0, 1, 0}, {1, 0x1p-63f, 0});
-  for (const Tracer* t : {static_cast<const Tracer*>(&exact), static_cast<const Tracer*>(&certified)}) {
+  for (const Accelerator* t : {static_cast<const Accelerator*>(&exact), static_cast<const Accelerator*>(&certified)}) {
     const Hit h = t->trace(r);
     CHECK(h.prim == 0);
     CHECK(h.t == 0x1p40f);
@@ -153,7 +153,7 @@ TEST_CASE("exact reference: a hit beyond the float range rounds to infinity", "[
   const ExactTracer exact(s);
   const CertifiedBruteTracer certified(s);
   const float inf = std::numeric_limits<float>::infinity();
-  for (const Tracer* t : {static_cast<const Tracer*>(&exact), static_cast<const Tracer*>(&certified)}) {
+  for (const Accelerator* t : {static_cast<const Accelerator*>(&exact), static_cast<const Accelerator*>(&certified)}) {
     // t = 1 / 1e-40, about 1e40: beyond every float.
     Hit h;
     REQUIRE_NOTHROW(h = t->trace(ray_of({0.25f, 0.25f, 0}, {0, 0, 1e-40f})));

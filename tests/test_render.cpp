@@ -12,7 +12,7 @@
 #include "apps/ray_offset.h"
 #include "apps/render.h"
 #include "geometry/default_scene.h"
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "robust/degenerate.h"
 #include "traverse/brute_force.h"
 #include "builder/accel_factory.h"

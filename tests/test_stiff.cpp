@@ -14,9 +14,9 @@
 #include <cstdlib>
 #include <optional>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "geometry/load_mesh.h"
-#include "geometry/ray_io.h"
+#include "bsprt/io.h"
 #include "geometry/stiff_rays.h"
 #include "geometry/stiff_scenes.h"
 #include "stiff_util.h"

@@ -10,8 +10,8 @@
 #include <random>
 #include <vector>
 
-#include "geometry/error.h"
-#include "geometry/ray.h"
+#include "bsprt/error.h"
+#include "bsprt/ray.h"
 #include "geometry/triangle_soup.h"
 #include "traverse/brute_force.h"
 #include "traverse/cpu_features.h"

@@ -46,7 +46,7 @@ std::size_t total_rays() {
 }
 
 /// Misses of `t` over `n` inside rays, generated and traced in chunks.
-std::size_t count_leaks(const Tracer& t, const ClosedCase& c, std::size_t n) {
+std::size_t count_leaks(const Accelerator& t, const ClosedCase& c, std::size_t n) {
   constexpr std::size_t kChunk = std::size_t(1) << 18;
   std::size_t leaks = 0;
   for (std::size_t done = 0, chunk = 0; done < n; done += kChunk, ++chunk) {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "traverse/cpu_features.h"
 #include "traverse/watertight.h"
 #include "traverse/watertight_packet_brute.h"

@@ -4,13 +4,13 @@
 /// watertight test. Slow and obviously right; the reference for tree tests.
 
 #include "geometry/triangle_soup.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 #include "traverse/watertight_packet_brute.h"
 
 namespace bsprt {
 
 /// Tests every triangle of the soup. Holds a reference: `soup` must outlive it.
-class BruteForceTracer final : public Tracer {
+class BruteForceTracer final : public Accelerator {
  public:
   explicit BruteForceTracer(const TriangleSoup& soup);
   std::string name() const override { return "brute"; }

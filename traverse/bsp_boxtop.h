@@ -20,7 +20,7 @@
 #include <span>
 #include <vector>
 
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 #include "traverse/bsp_compact.h"
 #include "traverse/bsp_node.h"
 

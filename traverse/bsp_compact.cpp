@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 namespace {

@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "traverse/bsp_compact.h"
 #include "traverse/bsp_node.h"
 #include "traverse/leaf_intersector.h"

@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "geometry/vec3.h"
+#include "bsprt/vec3.h"
 
 namespace bsprt {
 

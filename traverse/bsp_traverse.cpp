@@ -11,7 +11,7 @@
 #include <string>
 #include <utility>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "traverse/bsp_kernel.h"
 #include "traverse/cpu_features.h"
 #include "traverse/simd.h"

@@ -19,7 +19,7 @@
 #include "traverse/bsp_compact.h"
 #include "traverse/bsp_node.h"
 #include "traverse/leaf_intersector.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
@@ -61,9 +61,9 @@ bool rays_look_coherent(std::span<const Ray> rays);
 /// tfar = +inf (an empty batch: false). Picks the single-ray kernel only.
 bool rays_unbounded(std::span<const Ray> rays);
 
-/// The flat BSP tree behind the Tracer interface. Copies the triangle corners
+/// The flat BSP tree behind the Accelerator interface. Copies the triangle corners
 /// it needs, so the soup need not outlive it.
-class BspTracer final : public Tracer {
+class BspTracer final : public Accelerator {
  public:
   /// Takes ownership of `tree`, built for `soup`. Throws UsageError when the
   /// tree fails FlatBspTree::validate(), is deeper than kBspMaxDepth (128), or

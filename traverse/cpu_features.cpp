@@ -1,6 +1,6 @@
 #include "traverse/cpu_features.h"
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 

@@ -1,5 +1,5 @@
 /// \file embree_tracer.cpp
-/// Embree 3 behind the Tracer interface.
+/// Embree 3 behind the Accelerator interface.
 ///
 /// Degenerate triangles: Embree's own handling of zero-area triangles is not
 /// documented, so they are not given to Embree at all. The index buffer holds
@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 
 namespace bsprt {
 

@@ -1,13 +1,13 @@
 #pragma once
 /// \file embree_tracer.h
-/// Embree 3 behind the Tracer interface: the peer in benchmarks, an oracle in
+/// Embree 3 behind the Accelerator interface: the peer in benchmarks, an oracle in
 /// tests. Robust mode (RTC_SCENE_FLAG_ROBUST) by default, as in the design's
 /// error measurements; the default mode can be asked for to measure it too.
 
 #include <memory>
 
 #include "geometry/triangle_soup.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
@@ -28,7 +28,7 @@ const char* embree_cannot_trace(const Ray& r);
 /// (is_valid) are misses; a valid ray Embree cannot trace (tnear < 0, or an
 /// origin or direction component above 1.844e18 in magnitude) is a UsageError
 /// naming it (index within the batch), thrown before any ray of the batch is traced.
-class EmbreeTracer final : public Tracer {
+class EmbreeTracer final : public Accelerator {
  public:
   EmbreeTracer(const TriangleSoup& soup, const EmbreeConfig& config = {});
   ~EmbreeTracer() override;

@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "traverse/counters.h"
 #include "traverse/kd_traverse.h"
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "geometry/error.h"
+#include "bsprt/error.h"
 #include "traverse/cpu_features.h"
 #include "traverse/kd_kernel.h"
 #include "traverse/watertight.h"

@@ -13,7 +13,7 @@
 
 #include "geometry/triangle_soup.h"
 #include "traverse/kd_tree.h"
-#include "traverse/tracer.h"
+#include "traverse/accelerator.h"
 
 namespace bsprt {
 
@@ -27,9 +27,9 @@ struct KdTriangle {
   Vec3f v[3];
 };
 
-/// The kd-tree behind the Tracer interface. Copies the triangle corners it
+/// The kd-tree behind the Accelerator interface. Copies the triangle corners it
 /// needs, so the soup need not outlive it.
-class KdTracer final : public Tracer {
+class KdTracer final : public Accelerator {
  public:
   /// Takes ownership of `tree`, built for `soup`. Throws UsageError when the
   /// tree fails KdTree::validate(), is deeper than kKdMaxDepth, or was built

@@ -11,7 +11,7 @@
 #include <span>
 #include <string>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "traverse/counters.h"
 
 namespace bsprt {

@@ -23,7 +23,7 @@
 #include <optional>
 #include <utility>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "traverse/simd.h"
 
 namespace bsprt {

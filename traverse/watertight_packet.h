@@ -17,7 +17,7 @@
 #include <limits>
 #include <span>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "traverse/simd.h"
 #include "traverse/watertight.h"
 

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <span>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "geometry/triangle_soup.h"
 #include "traverse/counters.h"
 

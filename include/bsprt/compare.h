@@ -1,12 +1,12 @@
 #pragma once
-/// \file hit_compare.h
+/// \file compare.h
 /// Ray-by-ray comparison of a tested hit file against a reference, with the
-/// categories of shared/formats.md and the error vocabulary of DESIGN.md.
+/// categories of shared/formats.md and the error vocabulary of `bsprt compare`.
 
 #include <cstdint>
 #include <span>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 
 namespace bsprt {
 

@@ -1,5 +1,5 @@
 #pragma once
-/// \file tracer.h
+/// \file accelerator.h
 /// The one interface every accelerator and oracle implements (brute force, kd,
 /// BSP, Embree), so the CLI, tests and benchmarks can swap them by name.
 
@@ -8,15 +8,15 @@
 #include <span>
 #include <string>
 
-#include "geometry/ray.h"
+#include "bsprt/ray.h"
 #include "traverse/counters.h"
 
 namespace bsprt {
 
 /// Nearest-hit ray tracer over one fixed scene.
-class Tracer {
+class Accelerator {
  public:
-  virtual ~Tracer() = default;
+  virtual ~Accelerator() = default;
 
   /// Short name as used by `--accel` ("brute", "kd", "bsp", "embree").
   virtual std::string name() const = 0;

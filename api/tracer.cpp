@@ -1,0 +1,108 @@
+/// \file tracer.cpp
+/// bsprt::Tracer (include/bsprt/tracer.h): a row of the accelerator table
+/// (builder/accel_factory.h) made over a Scene, with a tree from memory.
+#include "bsprt/tracer.h"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include "builder/accel_factory.h"
+
+namespace bsprt {
+
+struct Tracer::Impl {
+  Scene scene;  // keeps the soup the accelerator points into alive
+  std::unique_ptr<Accelerator> accel;
+  std::string name;
+  bool certified = false;
+};
+
+Tracer::Tracer(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
+
+namespace {
+
+/// The `--accel` name of `mode` on a tree of `kind`.
+std::string accel_for(TreeKind kind, std::string_view mode) {
+  const std::string m(mode);
+  if (kind == TreeKind::Kd) {
+    if (m == "float" || m == "kd") return "kd";
+    throw UsageError("mode '" + m + "' is not a kd-tree mode (kd-trees trace in mode 'float')");
+  }
+  if (m == "certified") return "bsp-certified";
+  if (m == "float") return "bsp";
+  if (m == "zero-eps" || m == "top" || m == "top-certified") return "bsp-" + m;
+  if (accel_info(m).tree == AccelTree::Bsp) return m;  // throws UsageError for unknown names
+  throw UsageError("mode '" + m +
+                   "' is not a BSP mode (certified, float, zero-eps, top, top-certified or a bsp* accelerator)");
+}
+
+std::shared_ptr<Tracer::Impl> make(const Scene& scene, const std::string& accel, const Tree* tree) {
+  AccelOptions options;
+  if (tree) {
+    if (tree->scene().fingerprint() != scene.fingerprint() || tree->scene().triangle_count() != scene.triangle_count())
+      throw UsageError("Tracer: the tree was built for another scene (fingerprint mismatch)");
+    options.tree_file = tree->file();  // immutable and shared: no copy of the tree file
+  }
+  return std::make_shared<Tracer::Impl>(
+      Tracer::Impl{scene, make_tracer(accel, scene.soup(), options), accel, accel_info(accel).certified});
+}
+
+/// Runs body(begin, end) over [0, n) in blocks, on the threads `o` asks for.
+template <typename F>
+void for_blocks(std::size_t n, const TraceOptions& o, F&& body) {
+  if (o.threads == 1) return body(std::size_t(0), n);
+  auto run = [&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+  };
+  if (o.threads > 1) return tbb::task_arena(o.threads).execute(run);
+  run();
+}
+
+void check_options(const TraceOptions& o) {
+  if (o.threads < 0) throw UsageError("TraceOptions::threads must be >= 0, not " + std::to_string(o.threads));
+  if (o.packet_width != 1 && o.packet_width != 4 && o.packet_width != 8 && o.packet_width != 16)
+    throw UsageError("TraceOptions::packet_width must be 1, 4, 8 or 16, not " + std::to_string(o.packet_width));
+}
+
+}  // namespace
+
+Tracer::Tracer(const Scene& scene, const Tree& tree, std::string_view mode)
+    : impl_(make(scene, accel_for(tree.kind(), mode), &tree)) {}
+
+Tracer Tracer::by_name(const Scene& scene, std::string_view accel) { return Tracer(make(scene, std::string(accel), nullptr)); }
+Tracer Tracer::exact(const Scene& scene) { return by_name(scene, "exact"); }
+std::vector<std::string> Tracer::accelerators() { return accel_names(); }
+
+std::string Tracer::name() const { return impl_->name; }
+bool Tracer::certified() const { return impl_->certified; }
+std::size_t Tracer::memory_bytes() const { return impl_->accel->memory_bytes(); }
+
+Hit Tracer::intersect(const Ray& ray) const { return impl_->accel->trace(ray); }
+
+void Tracer::intersect(std::span<const Ray> rays, std::span<Hit> hits, const TraceOptions& options) const {
+  check_options(options);
+  if (rays.size() != hits.size())
+    throw UsageError("intersect: " + std::to_string(rays.size()) + " rays but room for " + std::to_string(hits.size()) +
+                     " hits");
+  for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
+    impl_->accel->trace_batch(rays.subspan(b, e - b), hits.subspan(b, e - b), options.packet_width);
+  });
+}
+
+bool Tracer::occluded(const Ray& ray) const { return impl_->accel->trace(ray).hit(); }
+
+void Tracer::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded, const TraceOptions& options) const {
+  check_options(options);
+  if (rays.size() != occluded.size())
+    throw UsageError("occluded: " + std::to_string(rays.size()) + " rays but room for " +
+                     std::to_string(occluded.size()) + " answers");
+  for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
+    std::vector<Hit> hits(e - b);
+    impl_->accel->trace_batch(rays.subspan(b, e - b), hits, options.packet_width);
+    for (std::size_t i = b; i < e; ++i) occluded[i] = hits[i - b].hit() ? 1 : 0;
+  });
+}
+
+}  // namespace bsprt

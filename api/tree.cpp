@@ -1,0 +1,160 @@
+/// \file tree.cpp
+/// bsprt::Tree, build and verify (include/bsprt/tree.h): the builders and the
+/// independent verifier behind the public API, trees held as tree-file images.
+#include "bsprt/tree.h"
+
+#include <oneapi/tbb/task_arena.h>
+
+#include <chrono>
+#include <fstream>
+#include <mutex>
+
+#include "builder/bsp_build.h"
+#include "builder/bsp_flat_io.h"
+#include "builder/bsp_flatten.h"
+#include "builder/kd_build.h"
+#include "builder/kd_file.h"
+#include "builder/tree_file.h"
+#include "builder/verify_file.h"
+#include "robust/verify.h"
+
+namespace bsprt {
+
+struct Tree::Impl {
+  Scene scene;
+  std::vector<std::byte> bytes;
+  std::shared_ptr<const TreeFileReader> reader;
+  double build_seconds = 0.0;
+};
+
+Tree::Tree(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+
+/// Progress and cancellation of one build: reports pass through `progress`,
+/// `cancel` is polled at each, and the last report is (total, total).
+struct BuildMonitor {
+  const BuildOptions& o;
+  void report(double done, double total) const {
+    if (o.cancel && o.cancel()) throw Cancelled();
+    if (o.progress) o.progress(done, total);
+  }
+};
+
+std::vector<std::byte> build_kd_bytes(const TriangleSoup& soup, const BuildOptions& o, const BuildMonitor& m) {
+  m.report(0, 1);
+  const KdConfig config;
+  auto run = [&] { return build_kd(soup, config); };
+  KdTree tree = o.threads > 0 ? tbb::task_arena(o.threads).execute(run) : run();
+  m.report(1, 1);
+  return kd_tree_file(tree, soup, config).bytes();
+}
+
+std::vector<std::byte> build_bsp_bytes(const TriangleSoup& soup, const BuildOptions& o, const BuildMonitor& m) {
+  BspConfig config;
+  config.threads = o.threads;
+  config.membership = o.membership == Membership::Closed ? BspMembership::Closed : BspMembership::Area;
+  BspBuildReport report;
+  const BspTree tree = build_bsp(soup, config, &report, [&m](double done, double total) { m.report(done, total); });
+  const FlatBspTree flat = flatten_bsp(soup, tree);
+  const BspReportRecord record{report.seconds, report.exact.filter_calls, report.exact.symbolic,
+                               report.exact.exact_fallbacks, report.exact.exact_points};
+  return bsp_tree_file(soup, tree, flat, &record).bytes();
+}
+
+}  // namespace
+
+Tree build(const Scene& scene, const BuildOptions& options) {
+  const auto t0 = Clock::now();
+  const BuildMonitor monitor{options};
+  auto impl = std::make_shared<Tree::Impl>(Tree::Impl{scene, {}, nullptr, 0.0});
+  impl->bytes = options.kind == TreeKind::Kd ? build_kd_bytes(scene.soup(), options, monitor)
+                                             : build_bsp_bytes(scene.soup(), options, monitor);
+  impl->reader = std::make_shared<const TreeFileReader>("(built in memory)", impl->bytes);
+  impl->build_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return Tree(std::move(impl));
+}
+
+Tree Tree::load(const std::string& path, const Scene& scene) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open tree file");
+  std::vector<char> chars((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(path, "cannot read tree file");
+  auto impl = std::make_shared<Impl>(Impl{scene, std::vector<std::byte>(chars.size()), nullptr, 0.0});
+  if (!chars.empty()) std::memcpy(impl->bytes.data(), chars.data(), chars.size());
+  impl->reader = std::make_shared<const TreeFileReader>(path, impl->bytes);
+  impl->reader->check_scene(scene.soup());
+  return Tree(std::move(impl));
+}
+
+void Tree::save(const std::string& path) const {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) throw InputError(path, "cannot create tree file");
+  f.write(reinterpret_cast<const char*>(impl_->bytes.data()), std::streamsize(impl_->bytes.size()));
+  f.close();
+  if (!f) throw InputError(path, "cannot write tree file");
+}
+
+TreeKind Tree::kind() const { return impl_->reader->kind(); }
+std::span<const std::byte> Tree::bytes() const { return impl_->bytes; }
+double Tree::build_seconds() const { return impl_->build_seconds; }
+const Scene& Tree::scene() const { return impl_->scene; }
+std::shared_ptr<const TreeFileReader> Tree::file() const { return impl_->reader; }
+
+namespace {
+
+Certificate verify_kd(const TriangleSoup& soup, const TreeFileReader& file) {
+  Certificate c;
+  const KdTree tree = read_kd_tree(file, soup);
+  const KdTreeStats st = kd_tree_stats(tree);
+  c.nodes = st.nodes;
+  c.leaves = st.leaves;
+  try {
+    validate_kd_coverage(tree, soup);
+    c.certified = true;
+  } catch (const std::logic_error& e) {
+    c.failure = e.what();
+  }
+  return c;
+}
+
+Certificate verify_bsp_tree(const TriangleSoup& soup, const TreeFileReader& file, const VerifyOptions& options) {
+  const VerifyInput in = read_verify_input(file, soup);
+  VerifyConfig internal;
+  internal.threads = options.threads;
+  internal.strict_extras = options.strict;
+  const VerifyReport r = verify_bsp(soup, in, internal);
+  Certificate c;
+  c.certified = r.certified;
+  c.nodes = r.nodes;
+  c.leaves = r.leaves;
+  c.pairs = r.pairs;
+  c.exact_fallbacks = r.exact_fallbacks;
+  if (r.failure) {
+    c.failure = r.failure->describe();
+    c.node = r.failure->node;
+    c.triangle = r.failure->triangle;
+    c.witness = r.failure->witness;
+  }
+  return c;
+}
+
+}  // namespace
+
+Certificate verify(const Scene& scene, const Tree& tree, const VerifyOptions& options) {
+  if (tree.scene().fingerprint() != scene.fingerprint() || tree.scene().triangle_count() != scene.triangle_count())
+    throw UsageError("verify: the tree was built for another scene (fingerprint mismatch)");
+  const auto t0 = Clock::now();
+  const TreeFileReader& file = *tree.file();
+  auto run = [&] {
+    return file.kind() == TreeKind::Kd ? verify_kd(scene.soup(), file) : verify_bsp_tree(scene.soup(), file, options);
+  };
+  Certificate c = options.threads > 0 ? tbb::task_arena(options.threads).execute(run) : run();
+  c.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return c;
+}
+
+}  // namespace bsprt

@@ -1,0 +1,77 @@
+#pragma once
+/// \file tracer.h
+/// Tracing rays against a scene with any bsprt accelerator, or with the exact
+/// reference: nearest hits and occlusion, single rays or spans of rays.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bsprt/ray.h"
+#include "bsprt/scene.h"
+#include "bsprt/tree.h"
+
+namespace bsprt {
+
+class Accelerator;
+
+/// How a span of rays is traced.
+struct TraceOptions {
+  /// 0 = all cores (oneTBB, blocks of 4096 rays), 1 = the calling thread only,
+  /// n = an arena of n threads. Hits do not depend on it.
+  int threads = 0;
+  /// 1 = single rays; 4, 8 or 16 = SIMD packets where the mode has them (the
+  /// CLI's --packets). Hits do not depend on it.
+  int packet_width = 1;
+};
+
+/// One accelerator over one scene. Safe to use from many threads at once.
+class Tracer {
+ public:
+  /// Traces `tree` (built for `scene`) in `mode`:
+  ///  - BSP trees: "certified" (default; exact-decision leaf test, hits equal the
+  ///    exact reference's), "float" (certified epsilons, float watertight leaf),
+  ///    "zero-eps", "top", "top-certified";
+  ///  - kd-trees: "float".
+  /// Any `--accel` name of that tree kind (e.g. "bsp-certified") is accepted too.
+  /// Throws UsageError for a mode the tree kind has not.
+  Tracer(const Scene& scene, const Tree& tree, std::string_view mode = "certified");
+
+  /// Any `--accel` accelerator by name (brute, brute-certified, exact, embree,
+  /// embree-fast, kd, bsp, ...); kd and BSP modes build their tree in memory.
+  static Tracer by_name(const Scene& scene, std::string_view accel);
+  /// The exact reference (CGAL AABB tree, exact predicates and parameters).
+  static Tracer exact(const Scene& scene);
+  /// The `--accel` names by_name accepts.
+  static std::vector<std::string> accelerators();
+
+  /// The accelerator's `--accel` name ("bsp-certified", "kd", "exact", ...).
+  std::string name() const;
+  /// True when every hit equals the exact reference's, bit for bit.
+  bool certified() const;
+  /// Bytes held by the acceleration structure.
+  std::size_t memory_bytes() const;
+
+  /// Nearest hit in [tnear, tfar]; invalid rays miss (formats.md).
+  Hit intersect(const Ray& ray) const;
+  /// hits[i] = intersect(rays[i]); throws UsageError when the sizes differ.
+  void intersect(std::span<const Ray> rays, std::span<Hit> hits, const TraceOptions& options = {}) const;
+  /// True when the ray hits anything in [tnear, tfar] (any-hit).
+  bool occluded(const Ray& ray) const;
+  /// occluded[i] = occluded(rays[i]) as 0/1; throws UsageError when the sizes differ.
+  void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                const TraceOptions& options = {}) const;
+
+ public:
+  struct Impl;  ///< the implementation (api/): opaque here
+
+ private:
+  explicit Tracer(std::shared_ptr<const Impl> impl);
+  std::shared_ptr<const Impl> impl_;
+};
+
+}  // namespace bsprt

@@ -1,0 +1,122 @@
+"""bsprt: exact general BSP trees and certified ray tracing, from numpy.
+
+    import numpy as np, bsprt
+    scene = bsprt.Scene.load("bunny.obj")            # or bsprt.Scene(vertices, faces)
+    tree = scene.build(accel="bsp")                   # exact BSP, certified float flattening
+    assert scene.verify(tree)["certified"]
+    tracer = bsprt.Tracer(scene, tree, mode="certified")
+    hits = tracer.intersect(origins, directions)      # hits.t, hits.prim, hits.u, hits.v
+
+Rays and hits cross the C++ boundary without copies where the layout allows:
+an (N, 8) float32 array of .rays records (org, tnear, dir, tfar) is traced in
+place (Tracer.intersect_rays), and hits come back as views of one HIT_DTYPE
+buffer. Bad arrays raise ValueError; bad files raise bsprt.InputError (a
+ValueError) naming the file and line. See docs/api.md.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple, Optional
+
+import numpy as np
+
+from ._bsprt import (HIT_DTYPE, Cancelled, InputError, Tree, __version__, compare,
+                     read_hits, read_rays, write_hits, write_rays)
+from ._bsprt import Scene
+from ._bsprt import _Tracer
+
+__all__ = ["Scene", "Tree", "Tracer", "Hits", "HIT_DTYPE", "InputError", "Cancelled", "compare",
+           "read_rays", "write_rays", "read_hits", "write_hits", "make_rays", "__version__"]
+
+NO_HIT = 0xFFFFFFFF
+
+
+class Hits(NamedTuple):
+    """Nearest hits: views of one HIT_DTYPE buffer (`records`). A miss is t=inf, prim=NO_HIT."""
+    t: np.ndarray
+    prim: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    records: np.ndarray
+
+
+def _hits(records: np.ndarray) -> Hits:
+    return Hits(records["t"], records["prim"], records["u"], records["v"], records)
+
+
+def _column(name: str, a, n: int, default: float) -> np.ndarray:
+    if a is None:
+        return np.full(n, default, dtype=np.float32)
+    a = np.asarray(a)
+    if a.ndim == 0:
+        a = np.full(n, a, dtype=a.dtype)
+    if a.dtype.kind != "f":
+        raise ValueError(f"{name}: expected a float array, got dtype {a.dtype}")
+    if a.shape != (n,):
+        raise ValueError(f"{name}: expected shape ({n},), got {a.shape}")
+    return a
+
+
+def make_rays(origins, directions, tnear=None, tfar=None) -> np.ndarray:
+    """Packs origins (N, 3), directions (N, 3), tnear and tfar (N,) or scalars into
+    the (N, 8) float32 .rays layout. Float64 input is rounded to float32 (the
+    precision bsprt traces in); NaN or reversed intervals make rays that miss."""
+    o = np.asarray(origins)
+    d = np.asarray(directions)
+    for name, a in (("origins", o), ("directions", d)):
+        if a.dtype.kind != "f":
+            raise ValueError(f"{name}: expected a float array, got dtype {a.dtype}")
+        if a.ndim != 2 or a.shape[1] != 3:
+            raise ValueError(f"{name}: expected shape (N, 3), got {a.shape}")
+    if o.shape != d.shape:
+        raise ValueError(f"origins {o.shape} and directions {d.shape} differ in shape")
+    n = o.shape[0]
+    rays = np.empty((n, 8), dtype=np.float32)
+    rays[:, 0:3] = o
+    rays[:, 3] = _column("tnear", tnear, n, 0.0)
+    rays[:, 4:7] = d
+    rays[:, 7] = _column("tfar", tfar, n, np.inf)
+    return rays
+
+
+class Tracer:
+    """Tracer(scene, tree, mode="certified") traces a built tree; Tracer(scene,
+    accel="embree") any accelerator by name; Tracer.exact(scene) the exact reference."""
+
+    def __init__(self, scene, tree: Optional[Tree] = None, mode: str = "certified",
+                 accel: Optional[str] = None):
+        if tree is not None and accel is not None:
+            raise ValueError("give either a tree (with a mode) or an accelerator name, not both")
+        if tree is None and accel is None:
+            raise ValueError("Tracer needs a tree (scene.build()) or accel=NAME")
+        self._t = _Tracer(scene, tree, mode) if tree is not None else _Tracer.by_name(scene, accel)
+        self._scene = scene
+
+    @staticmethod
+    def exact(scene) -> "Tracer":
+        """The exact reference: CGAL AABB tree, exact predicates and parameters."""
+        return Tracer(scene, accel="exact")
+
+    @staticmethod
+    def accelerators() -> list:
+        return _Tracer.accelerators()
+
+    name = property(lambda self: self._t.name)
+    certified = property(lambda self: self._t.certified)
+    memory_bytes = property(lambda self: self._t.memory_bytes)
+
+    def intersect_rays(self, rays: np.ndarray, threads: int = 0, packet_width: int = 1) -> Hits:
+        """Nearest hits of an (N, 8) float32 array of .rays records, traced in place."""
+        return _hits(self._t._intersect_rays(rays, threads, packet_width))
+
+    def intersect(self, origins, directions, tnear=None, tfar=None, threads: int = 0,
+                  packet_width: int = 1) -> Hits:
+        """Nearest hits in [tnear, tfar] (defaults 0 and inf): arrays t, prim, u, v."""
+        return self.intersect_rays(make_rays(origins, directions, tnear, tfar), threads, packet_width)
+
+    def occluded_rays(self, rays: np.ndarray, threads: int = 0, packet_width: int = 1) -> np.ndarray:
+        return self._t._occluded_rays(rays, threads, packet_width).astype(bool)
+
+    def occluded(self, origins, directions, tnear=None, tfar=None, threads: int = 0,
+                 packet_width: int = 1) -> np.ndarray:
+        """True where the ray hits anything in [tnear, tfar] (shadow / any-hit rays)."""
+        return self.occluded_rays(make_rays(origins, directions, tnear, tfar), threads, packet_width)

@@ -1,0 +1,209 @@
+"""Every binding of the bsprt module against the CLI's own results on the
+shared meshes (bit for bit), and bad input: a clear ValueError, never a crash."""
+import os
+
+import numpy as np
+import pytest
+
+import bsprt
+from conftest import cli
+
+
+def test_version_and_accelerators():
+    assert bsprt.__version__.count(".") == 2
+    names = bsprt.Tracer.accelerators()
+    assert {"bsp", "bsp-certified", "kd", "exact", "embree"} <= set(names)
+
+
+def test_scene_load_and_arrays(suzanne):
+    s = bsprt.Scene.load(suzanne)
+    assert s.triangle_count == 968 and s.vertex_count == 507
+    assert "triangles   968" in cli("info", suzanne)
+    assert s.summary["degenerate"] == 0
+    (lo, hi) = s.bounds
+    assert all(a < b for a, b in zip(lo, hi))
+    assert bsprt.Scene.load("default").fingerprint == bsprt.Scene.default().fingerprint
+    # The same soup from arrays: one vertex triple per triangle.
+    tri = np.array([[s_c for s_c in corner] for corner in _corners(s)], dtype=np.float32)
+    faces = np.arange(tri.shape[0], dtype=np.int64).reshape(-1, 3)
+    a = bsprt.Scene(tri, faces)
+    assert a.fingerprint == s.fingerprint
+
+
+def _corners(scene):
+    """Corner coordinates of every triangle, via a BSP-free route: the exact
+    reference's hits are not needed, the CLI's OBJ is parsed here."""
+    verts, faces = [], []
+    with open(scene.summary["source"]) as f:
+        for line in f:
+            p = line.split()
+            if not p:
+                continue
+            if p[0] == "v":
+                verts.append([float(x) for x in p[1:4]])
+            elif p[0] == "f":
+                idx = [int(x.split("/")[0]) - 1 for x in p[1:]]
+                for j in range(1, len(idx) - 1):
+                    faces.append([idx[0], idx[j], idx[j + 1]])
+    v = np.array(verts, dtype=np.float32)
+    return v[np.array(faces).reshape(-1)]
+
+
+def test_bad_arrays_raise_value_error():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32)
+    f = np.array([[0, 1, 2]], dtype=np.int32)
+    assert bsprt.Scene(v, f).triangle_count == 1
+    with pytest.raises(ValueError, match="float32"):
+        bsprt.Scene(v.astype(np.float64), f)
+    with pytest.raises(ValueError, match="shape"):
+        bsprt.Scene(v[:, :2].copy(), f)
+    with pytest.raises(ValueError, match="integer"):
+        bsprt.Scene(v, f.astype(np.float32))
+    with pytest.raises(ValueError, match="out of range"):
+        bsprt.Scene(v, np.array([[0, 1, 3]]))
+    with pytest.raises(ValueError, match="out of range"):
+        bsprt.Scene(v, np.array([[0, -1, 2]]))
+    with pytest.raises(ValueError, match="no triangles"):
+        bsprt.Scene(v, np.zeros((0, 3), dtype=np.uint32))
+    nan = v.copy()
+    nan[1, 0] = np.nan
+    with pytest.raises(ValueError, match="not finite"):
+        bsprt.Scene(nan, f)
+    kept = bsprt.Scene(nan, f, allow_nonfinite=True)
+    assert kept.summary["nonfinite_triangles"] == 1 and kept.summary["degenerate"] == 1
+    # Non-contiguous vertices are accepted (copied).
+    wide = np.zeros((3, 6), dtype=np.float32)
+    wide[:, ::2] = v
+    assert bsprt.Scene(wide[:, ::2], f).fingerprint == bsprt.Scene(v, f).fingerprint
+
+
+def test_bad_files_raise_input_error(tmp_path, scenes):
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nf 1 2 7\n")
+    with pytest.raises(bsprt.InputError, match="bad.obj:3"):
+        bsprt.Scene.load(str(bad))
+    with pytest.raises(ValueError):  # InputError is a ValueError
+        bsprt.Scene.load(str(tmp_path / "missing.ply"))
+    with pytest.raises(bsprt.InputError):
+        bsprt.read_rays(str(bad))
+
+
+@pytest.mark.parametrize("accel,mode,cli_mode", [("bsp", "certified", "bsp-certified"), ("bsp", "float", "bsp"),
+                                                 ("bsp", "top", "bsp-top"), ("kd", "float", "kd")])
+def test_trace_equals_cli(tmp_path, suzanne, accel, mode, cli_mode):
+    rays_path, tree_path, hits_path = tmp_path / "r.rays", tmp_path / "t.tree", tmp_path / "h.hits"
+    cli("gen-rays", suzanne, "--kind", "vertex", "-n", 3000, "-o", rays_path)
+    cli("build", suzanne, "--accel", accel, "-o", tree_path)
+    cli("trace", suzanne, rays_path, "-o", hits_path, "--accel", cli_mode, "--tree", tree_path)
+    scene = bsprt.Scene.load(suzanne)
+    expected = bsprt.read_hits(str(hits_path))
+    rays = bsprt.read_rays(str(rays_path))
+    for tree in (bsprt.Tree.load(str(tree_path), scene), scene.build(accel=accel)):
+        t = bsprt.Tracer(scene, tree, mode=mode)
+        assert t.name == cli_mode
+        h = t.intersect_rays(rays)
+        assert h.records.tobytes() == expected.tobytes()
+        # origins/directions/tnear/tfar give the same rays, hence the same hits.
+        h2 = t.intersect(rays[:, 0:3], rays[:, 4:7], rays[:, 3], rays[:, 7], threads=1, packet_width=8)
+        assert h2.records.tobytes() == expected.tobytes()
+        assert np.array_equal(h.prim != bsprt.NO_HIT, t.occluded_rays(rays))
+    out = tmp_path / "api.hits"
+    bsprt.write_hits(str(out), h.records)
+    assert out.read_bytes() == hits_path.read_bytes()
+
+
+def test_certified_equals_exact_and_compare(tmp_path, suzanne):
+    scene = bsprt.Scene.load(suzanne)
+    rays_path = tmp_path / "e.rays"
+    cli("gen-rays", suzanne, "--kind", "edge", "-n", 3000, "-o", rays_path)
+    rays = bsprt.read_rays(str(rays_path))
+    exact = bsprt.Tracer.exact(scene).intersect_rays(rays)
+    cert = bsprt.Tracer(scene, scene.build(), mode="certified")
+    assert cert.certified
+    h = cert.intersect_rays(rays)
+    # The exact reference's t (bit for bit) and triangle; u, v are float results.
+    assert h.t.tobytes() == exact.t.tobytes() and np.array_equal(h.prim, exact.prim)
+    r = bsprt.compare(exact.records, h.records)
+    assert r["agrees"] and r["lost"] == 0 and r["rays"] == len(rays)
+    lost = h.records.copy()
+    i = int(np.argmax(lost["prim"] != bsprt.NO_HIT))
+    lost[i] = (np.inf, bsprt.NO_HIT, 0, 0)
+    r = bsprt.compare(exact.records, lost)
+    assert r["lost"] == 1 and r["first_bad_ray"] == i and not r["agrees"]
+    a, b = tmp_path / "a.hits", tmp_path / "b.hits"
+    bsprt.write_hits(str(a), exact.records)
+    bsprt.write_hits(str(b), lost)
+    import subprocess
+    from conftest import CLI
+    out = subprocess.run([CLI, "compare", str(a), str(b)], capture_output=True, text=True)
+    assert out.returncode == 1
+    with pytest.raises(ValueError):
+        bsprt.compare(exact.records, lost[:10])
+    with pytest.raises(ValueError):
+        bsprt.compare(exact.records, np.zeros(len(rays), dtype=np.float32))
+
+
+def test_bad_rays_raise_value_error(suzanne):
+    scene = bsprt.Scene.load(suzanne)
+    t = bsprt.Tracer(scene, accel="brute")
+    o = np.zeros((4, 3), dtype=np.float32)
+    d = np.ones((4, 3), dtype=np.float32)
+    assert len(t.intersect(o, d).t) == 4
+    with pytest.raises(ValueError, match="shape"):
+        t.intersect(o[:, :2], d)
+    with pytest.raises(ValueError, match="differ"):
+        t.intersect(o[:3], d)
+    with pytest.raises(ValueError, match="float"):
+        t.intersect(o.astype(np.int32), d)
+    with pytest.raises(ValueError, match="tnear"):
+        t.intersect(o, d, tnear=np.zeros(3))
+    with pytest.raises(ValueError, match="dtype"):
+        t.intersect_rays(np.zeros((4, 8), dtype=np.float64))
+    with pytest.raises(ValueError, match="shape"):
+        t.intersect_rays(np.zeros((4, 7), dtype=np.float32))
+    with pytest.raises(ValueError, match="packet_width"):
+        t.intersect(o, d, packet_width=3)
+    # NaN rays are invalid rays: they miss (formats.md), no error.
+    h = t.intersect(np.full((2, 3), np.nan), d[:2])
+    assert np.all(h.prim == bsprt.NO_HIT) and np.all(np.isinf(h.t))
+    with pytest.raises(ValueError):
+        bsprt.Tracer(scene)
+    with pytest.raises(ValueError):
+        bsprt.Tracer(scene, accel="no-such-accel")
+    with pytest.raises(ValueError):
+        bsprt.Tracer(scene, scene.build(accel="kd"), mode="certified")
+    with pytest.raises(ValueError):
+        scene.build(accel="octree")
+
+
+def test_tree_save_load_verify(tmp_path, suzanne):
+    scene = bsprt.Scene.load(suzanne)
+    for accel in ("bsp", "kd"):
+        calls = []
+        tree = scene.build(accel=accel, progress=lambda d, t: calls.append((d, t)))
+        assert calls and calls[-1][0] == calls[-1][1]
+        assert tree.kind == accel and tree.nbytes > 40
+        cert = scene.verify(tree)
+        assert cert["certified"] and cert["failure"] == ""
+        p = tmp_path / f"{accel}.tree"
+        tree.save(str(p))
+        assert "CERTIFIED" in cli("verify", suzanne, p)
+        again = bsprt.Tree.load(str(p), scene)
+        assert again.nbytes == tree.nbytes
+        with pytest.raises(bsprt.InputError):
+            bsprt.Tree.load(str(p), bsprt.Scene.default())
+        data = bytearray(p.read_bytes())
+        data[len(data) // 2] ^= 1
+        p.write_bytes(bytes(data))
+        with pytest.raises(bsprt.InputError, match="CRC"):
+            bsprt.Tree.load(str(p), scene)
+
+
+def test_progress_exception_cancels_build(suzanne):
+    scene = bsprt.Scene.load(suzanne)
+
+    def stop(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        scene.build(accel="bsp", progress=stop)

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# CTest "consumer_project": installs the build tree into a temporary prefix,
+# builds examples/consumer against it with find_package(bsprt), and runs it on
+# a shared mesh. Usage: consumer_test.sh SOURCE_DIR BUILD_DIR MESH
+set -euo pipefail
+src=$1 build=$2 mesh=$3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cmake --install "$build" --prefix "$tmp/prefix" > "$tmp/install.log"
+# The installed headers must stand alone: none includes CGAL, Embree, TBB or OpenMesh.
+if grep -rnE '#include *<(CGAL|embree|tbb|oneapi|OpenMesh)' "$tmp/prefix/include/bsprt"; then
+  echo "consumer_test: an installed public header includes a dependency's header" >&2
+  exit 1
+fi
+cmake -S "$src/examples/consumer" -B "$tmp/consumer" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+      -DCMAKE_PREFIX_PATH="$tmp/prefix" > "$tmp/configure.log"
+cmake --build "$tmp/consumer" > "$tmp/build.log"
+"$tmp/consumer/consumer" "$mesh"
+"$tmp/prefix/bin/bsprt" info "$mesh" > /dev/null

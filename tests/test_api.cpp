@@ -1,0 +1,297 @@
+// The public API (include/bsprt/, docs/api.md) against the CLI's own output:
+// the same tree files, rays and hits files, bit for bit. Uses only the public
+// headers and links only libbsprt (bsprt::bsprt).
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <vector>
+
+#include "bsprt/bsprt.h"
+#include "test_util.h"
+
+using namespace bsprt;
+
+namespace {
+
+std::vector<char> file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+bool same_hits(std::span<const Hit> a, std::span<const Hit> b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Hit)) == 0);
+}
+
+/// Same t (bits) and triangle on every ray: what "certified" promises (the
+/// barycentrics u, v are float results of the leaf test, not exact ones).
+bool same_t_and_prim(std::span<const Hit> a, std::span<const Hit> b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i].t, &b[i].t, sizeof(float)) != 0 || a[i].prim != b[i].prim) return false;
+  return true;
+}
+
+/// CLI-written rays, a CLI-built tree of `accel`, and the CLI's hits of `mode` on them.
+struct CliRun {
+  std::string rays, tree, hits;
+};
+
+CliRun cli_trace(const std::string& scene, const std::string& tag, const std::string& kind, const std::string& build,
+                 const std::string& mode) {
+  CliRun r{test::temp_path("api-" + tag + ".rays"), test::temp_path("api-" + tag + "." + build + ".tree"),
+           test::temp_path("api-" + tag + "." + mode + ".hits")};
+  REQUIRE(test::bsprt_cli("gen-rays " + scene + " --kind " + kind + " -n 4000 -o " + r.rays).status == 0);
+  REQUIRE(test::bsprt_cli("build " + scene + " --accel " + build + " -o " + r.tree).status == 0);
+  REQUIRE(test::bsprt_cli("trace " + scene + " " + r.rays + " -o " + r.hits + " --accel " + mode + " --tree " + r.tree)
+              .status == 0);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("api: Scene::load counts what the CLI counts", "[api]") {
+  const Scene s = Scene::load(test::scene_path("suzanne.obj"));
+  CHECK(s.triangle_count() == 968);
+  CHECK(s.vertex_count() == 507);
+  CHECK(s.summary().degenerate == 0);
+  const test::CliRun info = test::bsprt_cli("info " + test::scene_path("suzanne.obj"));
+  REQUIRE(info.status == 0);
+  CHECK(info.output.find("triangles   968") != std::string::npos);
+  const Scene d = Scene::load("default");
+  CHECK(d.triangle_count() == 6400);
+  CHECK(d.fingerprint() == Scene::default_scene().fingerprint());
+  CHECK_THROWS_AS(Scene::load(test::temp_path("no-such-mesh.obj")), InputError);
+  CHECK_THROWS_AS(Scene::load(test::scene_path("stiff_test-nan.obj")), InputError);
+  SceneOptions keep;
+  keep.allow_nonfinite = true;
+  const Scene nan = Scene::load(test::scene_path("stiff_test-nan.obj"), keep);
+  CHECK(nan.summary().nonfinite_triangles > 0);
+  CHECK(nan.summary().degenerate >= nan.summary().nonfinite_triangles);
+}
+
+TEST_CASE("api: Scene::from_arrays equals the loaded scene and rejects bad arrays", "[api]") {
+  const Scene s = Scene::load(test::scene_path("suzanne.obj"));
+  std::vector<float> v;
+  std::vector<std::uint32_t> idx;
+  // Rebuild the soup from its corners (3 vertices a triangle): same fingerprint.
+  for (std::size_t t = 0; t < s.triangle_count(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3f p = s.corner(t, k);
+      v.insert(v.end(), {p.x, p.y, p.z});
+      idx.push_back(std::uint32_t(idx.size()));
+    }
+  const Scene a = Scene::from_arrays(v, idx);
+  CHECK(a.fingerprint() == s.fingerprint());
+  CHECK(a.triangle_count() == s.triangle_count());
+  CHECK(a.summary().unreferenced_vertices == 0);
+  CHECK_THROWS_AS(s.corner(968, 0), UsageError);
+  CHECK_THROWS_AS(Scene::from_arrays(std::span(v).first(v.size() - 1), idx), UsageError);
+  CHECK_THROWS_AS(Scene::from_arrays(v, std::span(idx).first(idx.size() - 1)), UsageError);
+  CHECK_THROWS_AS(Scene::from_arrays(v, {}), UsageError);
+  std::vector<std::uint32_t> bad = idx;
+  bad[5] = std::uint32_t(v.size() / 3);
+  CHECK_THROWS_WITH(Scene::from_arrays(v, bad), Catch::Contains("triangle 1 corner 2"));
+  std::vector<float> nan = v;
+  nan[4] = std::numeric_limits<float>::quiet_NaN();
+  CHECK_THROWS_AS(Scene::from_arrays(nan, idx), UsageError);
+  SceneOptions keep;
+  keep.allow_nonfinite = true;
+  const Scene kept = Scene::from_arrays(nan, idx, keep);
+  CHECK(kept.summary().nonfinite_triangles == 1);
+  CHECK(kept.summary().degenerate == 1);
+  // Repeated corners are degenerate, kept and counted, never hit.
+  std::vector<std::uint32_t> rep = idx;
+  rep[1] = rep[0];
+  CHECK(Scene::from_arrays(v, rep).summary().degenerate == 1);
+}
+
+TEST_CASE("api: trees built, saved and loaded trace what the CLI traces", "[api]") {
+  const std::string path = test::scene_path("suzanne.obj");
+  const Scene scene = Scene::load(path);
+  for (const char* accel : {"bsp", "kd"}) {
+    const std::string mode = accel == std::string("bsp") ? "bsp-certified" : "kd";
+    const CliRun cli = cli_trace(path, std::string("trees-") + accel, "vertex", accel, mode);
+    const std::vector<Ray> rays = read_rays(cli.rays);
+    const std::vector<Hit> expected = read_hits(cli.hits);
+    // The CLI's tree file, loaded through the API.
+    const Tree loaded = Tree::load(cli.tree, scene);
+    CHECK(loaded.kind() == (accel == std::string("bsp") ? TreeKind::Bsp : TreeKind::Kd));
+    std::vector<Hit> hits(rays.size());
+    Tracer(scene, loaded, accel == std::string("bsp") ? "certified" : "float").intersect(rays, hits);
+    CHECK(same_hits(hits, expected));
+    // A tree the API builds: saved, it is a tree file the CLI traces to the same hits.
+    BuildOptions o;
+    o.kind = loaded.kind();
+    const Tree built = build(scene, o);
+    const std::string saved = test::temp_path(std::string("api-saved.") + accel + ".tree");
+    built.save(saved);
+    CHECK(file_bytes(saved).size() == built.bytes().size());
+    const std::string again = test::temp_path(std::string("api-saved.") + accel + ".hits");
+    REQUIRE(test::bsprt_cli("trace " + path + " " + cli.rays + " -o " + again + " --accel " + mode + " --tree " + saved)
+                .status == 0);
+    CHECK(same_hits(read_hits(again), expected));
+    std::vector<Hit> mine(rays.size());
+    Tracer(scene, built, accel == std::string("bsp") ? "certified" : "float").intersect(rays, mine);
+    CHECK(same_hits(mine, expected));
+  }
+}
+
+TEST_CASE("api: Tree::load rejects corrupt files and other scenes", "[api]") {
+  const Scene scene = Scene::load(test::scene_path("suzanne.obj"));
+  BuildOptions o;
+  o.kind = TreeKind::Kd;
+  const Tree t = build(scene, o);
+  const std::string p = test::temp_path("api-corrupt.tree");
+  t.save(p);
+  CHECK_THROWS_AS(Tree::load(p, Scene::default_scene()), InputError);
+  std::vector<char> bytes = file_bytes(p);
+  bytes[bytes.size() / 2] ^= 0x10;
+  std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+  CHECK_THROWS_WITH(Tree::load(p, scene), Catch::Contains("CRC"));
+  CHECK_THROWS_AS(Tree::load(test::temp_path("api-missing.tree"), scene), InputError);
+  CHECK_THROWS_AS(t.save("/nonexistent-dir/x.tree"), InputError);
+  CHECK_THROWS_AS(Tracer(Scene::default_scene(), t, "float"), UsageError);  // tree of another scene
+}
+
+TEST_CASE("api: build reports progress to the total and can be cancelled", "[api]") {
+  const Scene scene = Scene::load(test::scene_path("suzanne.obj"));
+  for (TreeKind kind : {TreeKind::Bsp, TreeKind::Kd}) {
+    BuildOptions o;
+    o.kind = kind;
+    o.threads = 2;
+    double last = -1, total = 0;
+    bool monotonic = true;
+    o.progress = [&](double done, double tot) {
+      monotonic = monotonic && done >= last;
+      last = done;
+      total = tot;
+    };
+    const Tree t = build(scene, o);
+    CHECK(monotonic);
+    CHECK(last == total);
+    CHECK(total > 0);
+    CHECK(t.build_seconds() > 0);
+    BuildOptions c = o;
+    std::atomic<int> polls{0};
+    c.cancel = [&] { return ++polls >= 2; };
+    CHECK_THROWS_AS(build(scene, c), Cancelled);
+  }
+}
+
+TEST_CASE("api: verify certifies kd and BSP trees as bsprt verify does", "[api]") {
+  const std::string path = test::scene_path("suzanne.obj");
+  const Scene scene = Scene::load(path);
+  for (TreeKind kind : {TreeKind::Bsp, TreeKind::Kd}) {
+    BuildOptions o;
+    o.kind = kind;
+    const Tree t = build(scene, o);
+    const Certificate c = verify(scene, t);
+    CHECK(c.certified);
+    CHECK(c.failure.empty());
+    CHECK(c.leaves > 0);
+    const std::string saved = test::temp_path(kind == TreeKind::Bsp ? "api-verify.bsp.tree" : "api-verify.kd.tree");
+    t.save(saved);
+    const test::CliRun cli = test::bsprt_cli("verify " + path + " " + saved);
+    CHECK(cli.status == 0);
+    CHECK(cli.output.find("CERTIFIED") != std::string::npos);
+  }
+  CHECK_THROWS_AS(verify(Scene::default_scene(), build(scene)), UsageError);
+}
+
+TEST_CASE("api: every mode, packets and thread counts give the CLI's hits; occluded agrees", "[api]") {
+  const std::string path = test::scene_path("suzanne.obj");
+  const Scene scene = Scene::load(path);
+  const Tree bsp = build(scene);
+  const std::string tree = test::temp_path("api-modes.tree");
+  bsp.save(tree);
+  const std::string rays_path = test::temp_path("api-modes.rays");
+  REQUIRE(test::bsprt_cli("gen-rays " + path + " --kind edge -n 3000 -o " + rays_path).status == 0);
+  const std::vector<Ray> rays = read_rays(rays_path);
+  const std::pair<const char*, const char*> modes[] = {
+      {"certified", "bsp-certified"}, {"float", "bsp"}, {"zero-eps", "bsp-zero-eps"}, {"top", "bsp-top"},
+      {"top-certified", "bsp-top-certified"}};
+  std::vector<Hit> ref(rays.size());
+  const Tracer exact = Tracer::exact(scene);
+  CHECK(exact.certified());
+  exact.intersect(rays, ref);
+  for (const auto& [mode, accel] : modes) {
+    const std::string out = test::temp_path(std::string("api-modes.") + accel + ".hits");
+    REQUIRE(test::bsprt_cli("trace " + path + " " + rays_path + " -o " + out + " --accel " + accel + " --tree " + tree)
+                .status == 0);
+    const std::vector<Hit> expected = read_hits(out);
+    const Tracer t(scene, bsp, mode);
+    CHECK(t.name() == accel);
+    for (int threads : {1, 2, 0})
+      for (int packets : {1, 8}) {
+        std::vector<Hit> hits(rays.size());
+        TraceOptions o;
+        o.threads = threads;
+        o.packet_width = packets;
+        t.intersect(rays, hits, o);
+        INFO(mode << " threads " << threads << " packets " << packets);
+        CHECK(same_hits(hits, expected));
+      }
+    if (t.certified()) CHECK(same_t_and_prim(expected, ref));  // certified: the exact reference's t and triangle
+    std::vector<std::uint8_t> occ(rays.size());
+    t.occluded(rays, occ);
+    std::size_t agree = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) agree += (occ[i] != 0) == expected[i].hit();
+    CHECK(agree == rays.size());
+    CHECK(t.occluded(rays[0]) == expected[0].hit());
+    CHECK(same_hits(std::vector<Hit>{t.intersect(rays[1])}, std::vector<Hit>{expected[1]}));
+  }
+  std::vector<Hit> short_out(rays.size() - 1);
+  CHECK_THROWS_AS(Tracer(scene, bsp).intersect(rays, short_out), UsageError);
+  TraceOptions bad;
+  bad.packet_width = 3;
+  std::vector<Hit> hits(rays.size());
+  CHECK_THROWS_AS(Tracer(scene, bsp).intersect(rays, hits, bad), UsageError);
+  CHECK_THROWS_AS(Tracer(scene, bsp, "no-such-mode"), UsageError);
+  BuildOptions kd;
+  kd.kind = TreeKind::Kd;
+  CHECK_THROWS_AS(Tracer(scene, build(scene, kd), "certified"), UsageError);
+  CHECK_THROWS_AS(Tracer::by_name(scene, "no-such-accel"), UsageError);
+  const std::vector<std::string> names = Tracer::accelerators();
+  CHECK(std::find(names.begin(), names.end(), "embree") != names.end());
+  // A tree-less accelerator by name: Embree robust, against the CLI.
+  const std::string out = test::temp_path("api-modes.embree.hits");
+  REQUIRE(test::bsprt_cli("trace " + path + " " + rays_path + " -o " + out + " --accel embree").status == 0);
+  Tracer::by_name(scene, "embree").intersect(rays, hits);
+  CHECK(same_hits(hits, read_hits(out)));
+}
+
+TEST_CASE("api: compare and the ray/hit files agree with bsprt compare", "[api]") {
+  const std::string path = test::scene_path("suzanne.obj");
+  const Scene scene = Scene::load(path);
+  const std::string rays_path = test::temp_path("api-compare.rays");
+  REQUIRE(test::bsprt_cli("gen-rays " + path + " --kind random -n 2000 -o " + rays_path).status == 0);
+  const std::vector<Ray> rays = read_rays(rays_path);
+  const std::string copy = test::temp_path("api-compare-copy.rays");
+  write_rays(copy, rays);
+  CHECK(file_bytes(copy) == file_bytes(rays_path));
+  std::vector<Hit> ref(rays.size()), tested(rays.size());
+  Tracer::exact(scene).intersect(rays, ref);
+  tested = ref;
+  std::size_t first_hit = 0;
+  while (first_hit < ref.size() && !ref[first_hit].hit()) ++first_hit;
+  REQUIRE(first_hit < ref.size());
+  tested[first_hit] = Hit{};  // one lost hit
+  const HitComparison c = compare_hits(ref, tested);
+  CHECK(c.lost == 1);
+  CHECK(c.first_bad_ray == first_hit);
+  CHECK_FALSE(c.agrees());
+  CHECK(compare_hits(ref, ref).agrees());
+  const std::string a = test::temp_path("api-compare-ref.hits"), b = test::temp_path("api-compare-tested.hits");
+  write_hits(a, ref);
+  write_hits(b, tested);
+  const test::CliRun cli = test::bsprt_cli("compare " + a + " " + b);
+  CHECK(cli.status == 1);
+  CHECK(cli.output.find("lost") != std::string::npos);
+  CHECK_THROWS_AS(compare_hits(ref, std::span(tested).first(10)), UsageError);
+  CHECK(std::string(version()) == BSPRT_VERSION_STRING);
+}
