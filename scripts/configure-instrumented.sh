@@ -9,4 +9,4 @@ cd "$(dirname "$0")/.."
 # compile time of -O2 -g on the CGAL-heavy files.
 CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Sanitize \
   -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -gline-tables-only" \
-  -DBSPRT_BUILD_FUZZERS=ON -DBUILD_TESTING=ON -DBSPRT_BUILD_BENCH=OFF >/dev/null
+  -DBSPRT_BUILD_FUZZERS=ON -DBUILD_TESTING=ON -DBSPRT_BUILD_BENCH=OFF -DBSPRT_BUILD_PYTHON=OFF >/dev/null

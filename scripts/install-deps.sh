@@ -12,6 +12,8 @@ packages=(
   catch2 libbenchmark-dev                           # tests (Catch2 v2) and micro-benchmarks
   clang libclang-rt-dev                             # libFuzzer harnesses and sanitizers
   gnuplot-nox                                       # plots in docs/performance.md (scripts/docs.sh)
+  pybind11-dev python3-dev python3-numpy            # the Python module (python/)
+  python3-pytest python3-matplotlib                 # its tests and the docs/api.md example plot
 )
 
 missing=()

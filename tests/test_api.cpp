@@ -110,7 +110,7 @@ TEST_CASE("api: Scene::from_arrays equals the loaded scene and rejects bad array
   CHECK(Scene::from_arrays(v, rep).summary().degenerate == 1);
 }
 
-TEST_CASE("api: trees built, saved and loaded trace what the CLI traces", "[api]") {
+TEST_CASE("api: trees built or saved or loaded trace what the CLI traces", "[api]") {
   const std::string path = test::scene_path("suzanne.obj");
   const Scene scene = Scene::load(path);
   for (const char* accel : {"bsp", "kd"}) {
@@ -203,7 +203,7 @@ TEST_CASE("api: verify certifies kd and BSP trees as bsprt verify does", "[api]"
   CHECK_THROWS_AS(verify(Scene::default_scene(), build(scene)), UsageError);
 }
 
-TEST_CASE("api: every mode, packets and thread counts give the CLI's hits; occluded agrees", "[api]") {
+TEST_CASE("api: every mode at every packet width and thread count gives the CLI's hits and occluded agrees", "[api]") {
   const std::string path = test::scene_path("suzanne.obj");
   const Scene scene = Scene::load(path);
   const Tree bsp = build(scene);
