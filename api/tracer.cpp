@@ -3,11 +3,10 @@
 /// (builder/accel_factory.h) made over a Scene, with a tree from memory.
 #include "bsprt/tracer.h"
 
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
 #include "builder/accel_factory.h"
+#include "traverse/trace_parallel.h"
 
 namespace bsprt {
 
@@ -48,14 +47,12 @@ std::shared_ptr<Tracer::Impl> make(const Scene& scene, const std::string& accel,
       Tracer::Impl{scene, make_tracer(accel, scene.soup(), options), accel, accel_info(accel).certified});
 }
 
-/// Runs body(begin, end) over [0, n) in blocks, on the threads `o` asks for.
+/// Runs body(begin, end) over [0, n): on the calling thread (threads = 1) or in
+/// blocks of 4096 on an arena of `threads` (0 = all cores).
 template <typename F>
 void for_blocks(std::size_t n, const TraceOptions& o, F&& body) {
   if (o.threads == 1) return body(std::size_t(0), n);
-  auto run = [&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
-  };
+  auto run = [&] { for_each_block(n, 4096, body); };
   if (o.threads > 1) return tbb::task_arena(o.threads).execute(run);
   run();
 }

@@ -79,12 +79,7 @@ Tree build(const Scene& scene, const BuildOptions& options) {
 }
 
 Tree Tree::load(const std::string& path, const Scene& scene) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open tree file");
-  std::vector<char> chars((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path, "cannot read tree file");
-  auto impl = std::make_shared<Impl>(Impl{scene, std::vector<std::byte>(chars.size()), nullptr, 0.0});
-  if (!chars.empty()) std::memcpy(impl->bytes.data(), chars.data(), chars.size());
+  auto impl = std::make_shared<Impl>(Impl{scene, read_tree_file_image(path), nullptr, 0.0});
   impl->reader = std::make_shared<const TreeFileReader>(path, impl->bytes);
   impl->reader->check_scene(scene.soup());
   return Tree(std::move(impl));

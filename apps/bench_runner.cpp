@@ -28,6 +28,7 @@
 #include "geometry/ray_gen.h"
 #include "robust/exact_tracer.h"
 #include "traverse/cpu_features.h"
+#include "traverse/trace_parallel.h"
 
 namespace bsprt {
 namespace {
@@ -136,9 +137,9 @@ std::vector<BuiltMode> build_modes(const BenchScene& scene, const BenchOptions& 
 std::vector<Hit> exact_hits(const TriangleSoup& soup, const std::vector<Ray>& rays) {
   const ExactTracer exact(soup);
   std::vector<Hit> hits(rays.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 64), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i < range.end(); ++i) hits[i] = exact.trace(rays[i]);
-  });
+  ParallelTrace o;
+  o.block = 64;
+  trace_parallel(exact, rays, hits, o);
   return hits;
 }
 
@@ -219,12 +220,11 @@ double time_trace(const Accelerator& tracer, const std::vector<Ray>& rays, std::
   hits.assign(rays.size(), Hit{});
   double best = 1e30;
   for (int r = 0; r < std::max(1, runs); ++r) {
+    ParallelTrace o;
+    o.packet_width = width;
+    o.block = 1024;
     const auto t0 = Clock::now();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& range) {
-      const std::size_t n = range.end() - range.begin();
-      tracer.trace_batch(std::span<const Ray>(rays.data() + range.begin(), n),
-                         std::span<Hit>(hits.data() + range.begin(), n), width, nullptr);
-    });
+    trace_parallel(tracer, rays, hits, o);
     best = std::min(best, seconds_since(t0));
   }
   return best;
@@ -233,8 +233,9 @@ double time_trace(const Accelerator& tracer, const std::vector<Ray>& rays, std::
 /// Work per ray, counted in a separate single-ray pass (counters cost time).
 RayCounters count_work(const Accelerator& tracer, const std::vector<Ray>& rays) {
   tbb::combinable<RayCounters> local;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i < range.end(); ++i) tracer.trace(rays[i], &local.local());
+  // One trace() per ray, not trace_batch: the per-ray counters of the single-ray kernel.
+  for_each_block(rays.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) tracer.trace(rays[i], &local.local());
   });
   RayCounters sum;
   local.combine_each([&](const RayCounters& c) { sum += c; });

@@ -4,8 +4,8 @@
 /// requested accelerator and traces the SAME rays on the SAME threads in ONE
 /// process, measuring build seconds, Mrays/s (single rays and packets), work
 /// per ray (counters), memory, and error against the exact reference
-/// (ExactTracer) on a subset of the rays, in the vocabulary of DESIGN.md
-/// ("Error and its vocabulary"). Reports as Markdown, CSV and JSON
+/// (ExactTracer) on a subset of the rays, in the vocabulary of `bsprt compare`
+/// (include/bsprt/compare.h, formats.md). Reports as Markdown, CSV and JSON
 /// (bench_report.h). Prints nothing: progress goes through a callback.
 
 #include <cstddef>

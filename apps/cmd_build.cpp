@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include <memory>
+#include <optional>
 
 #include "apps/cli_common.h"
 #include "apps/progress.h"
@@ -129,29 +130,30 @@ void run_build(const BuildArgs& a) {
   throw UsageError("bsprt build: --accel must be kd or bsp, not '" + a.accel + "'");
 }
 
+/// Version 1 files' headers are not covered by their CRC: said, not hidden.
+std::string version_note(const TreeFileReader& file) {
+  return file.version() == 1 ? " (version 1 file: its header is not covered by the CRC)" : "";
+}
+
 void run_stats(const std::string& path) {
   const TreeFileReader file(path);
+  if (file.triangle_count() > 0xFFFFFFFFull)
+    throw InputError(path, "tree file header names " + std::to_string(file.triangle_count()) + " triangles (at most 2^32 - 1)");
   if (file.kind() == TreeKind::Kd) {
-    KdTree tree;
-    tree.nodes = file.array<KdNode>(kKdNodesTag);
-    tree.prims = file.array<std::uint32_t>(kKdPrimsTag);
-    const std::vector<float> b = file.array<float>(kKdBoundsTag);
-    if (b.size() != 6) throw InputError(path, "bounds section must hold 6 floats");
-    tree.bounds = {{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
-    tree.triangle_count = std::uint32_t(file.triangle_count());
-    tree.validate();
-    fmt::print("{}: kd-tree, ", path);
+    const KdTree tree = read_kd_sections(file, std::uint32_t(file.triangle_count()));
+    fmt::print("{}: kd-tree{}, ", path, version_note(file));
     print_kd_stats(kd_tree_stats(tree));
     return;
   }
-  fmt::print("{}: BSP tree for {} triangles, ", path, file.triangle_count());
-  const std::vector<BspReportRecord> rec = file.has_section(kBspReportTag)
-                                               ? file.array<BspReportRecord>(kBspReportTag)
-                                               : std::vector<BspReportRecord>{};
-  if (rec.size() == 1)
-    fmt::print("built in {:.3f} s, exact fallbacks {} of {} filtered side tests ({} symbolic), ", rec[0].seconds,
-               rec[0].exact_fallbacks, rec[0].filter_calls, rec[0].symbolic);
-  print_bsp_figures(bsp_figures(file.array<BspNode>(kBspNodesTag), file.array<PlaneDef>(kBspPlanesTag), path));
+  // Every section is read (and checked) before anything is printed.
+  const std::optional<BspReportRecord> rec =
+      file.has_section(kBspReportTag) ? std::optional(file.record<BspReportRecord>(kBspReportTag)) : std::nullopt;
+  const BspFigures figures = bsp_figures(file.array<BspNode>(kBspNodesTag), file.array<PlaneDef>(kBspPlanesTag), path);
+  fmt::print("{}: BSP tree for {} triangles{}, ", path, file.triangle_count(), version_note(file));
+  if (rec)
+    fmt::print("built in {:.3f} s, exact fallbacks {} of {} filtered side tests ({} symbolic), ", rec->seconds,
+               rec->exact_fallbacks, rec->filter_calls, rec->symbolic);
+  print_bsp_figures(figures);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "bsprt/error.h"
 #include "bsprt/io.h"
 #include "traverse/embree_tracer.h"
+#include "traverse/trace_parallel.h"
 
 namespace bsprt::cli {
 namespace {
@@ -56,16 +57,14 @@ FaceHitFigures count_face_hits(const TraceArgs& a, const TriangleSoup& soup, con
 /// Traces all rays in parallel blocks; returns the summed counters.
 RayCounters trace_all(const Accelerator& tracer, const std::vector<Ray>& rays, std::vector<Hit>& hits,
                       int packets, bool count) {
-  tbb::combinable<RayCounters> counters;
   ProgressBar bar("tracing", rays.size(), "rays", ProgressBar::stderr_is_terminal() && rays.size() > (1u << 20));
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 4096), [&](const auto& r) {
-    std::span<const Ray> in(rays.data() + r.begin(), r.size());
-    std::span<Hit> out(hits.data() + r.begin(), r.size());
-    tracer.trace_batch(in, out, packets, count ? &counters.local() : nullptr);
-    bar.advance(r.size());
-  });
+  ParallelTrace o;
+  o.packet_width = packets;
+  o.count = count;
+  o.on_block = [&bar](std::size_t n) { bar.advance(n); };
+  const RayCounters c = trace_parallel(tracer, rays, hits, o);
   bar.finish();
-  return counters.combine([](RayCounters a, const RayCounters& b) { return a += b; });
+  return c;
 }
 
 void run(const TraceArgs& a) {

@@ -1,6 +1,6 @@
 #pragma once
 /// \file bsh.h
-/// Counting with a bounding-sphere hierarchy (DESIGN.md "Counting with a BSH";
+/// Counting with a bounding-sphere hierarchy (docs/bsp-build.md "Counting";
 /// Ize, Wald, Parker, RT 2008, §3.3 and future work): for a candidate plane the
 /// SAH needs how many of the node's clipped triangles reach each child. A BVH of
 /// bounding spheres over the clipped triangles answers it without touching every

@@ -1,7 +1,7 @@
 #pragma once
 /// \file bsp_candidates.h
 /// Candidate split planes of one BSP node and their SAH costs (Ize, Wald,
-/// Parker, RT 2008, §3.2–§4; DESIGN.md "Costs"):
+/// Parker, RT 2008, §3.2–§4; docs/bsp-build.md "Costs"):
 ///  - kd candidates: axis-aligned float planes at the clipped triangles' bounds
 ///    (lower bound rounded down, upper rounded up to float), counted for all
 ///    planes of an axis by one sweep over sorted bounds (O(N log N));

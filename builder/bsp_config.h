@@ -25,7 +25,7 @@ enum class BspMembership : std::uint8_t {
   Area = 1,
 };
 
-/// Options of build_bsp. Costs follow DESIGN.md "Costs" (the reference
+/// Options of build_bsp. Costs follow docs/bsp-build.md "Costs" (the reference
 /// implementation of Ize, Wald, Parker 2008, §4): cost(split) = C_trav +
 /// C_isect·(P_L·N_L + P_R·N_R) with P = child cell area / parent cell area.
 struct BspConfig {
@@ -45,8 +45,8 @@ struct BspConfig {
   double min_gain = 1e-5;
   /// Evaluate face/edge (BSP) candidates only when the node holds at most this
   /// many triangles. Above it C_BSP ≥ 7.5·N so kd splits almost always win and
-  /// the O(N²)-ish BSP evaluation is wasted (DESIGN.md "Leave out what a scene
-  /// does not need"). 0 = kd-tree only; SIZE_MAX = the paper's full BSP.
+  /// the O(N²)-ish BSP evaluation is wasted (docs/bsp-build.md "Costs";
+  /// leave out what a scene does not need). 0 = kd-tree only; SIZE_MAX = the paper's full BSP.
   std::size_t bsp_max_triangles = 48;
   /// Count BSP candidates with the bounding-sphere hierarchy (bsh.h) when the
   /// node holds at least this many triangles; below it, a flat sphere list.

@@ -23,9 +23,7 @@ void add_bsp_sections(TreeFileWriter& w, const BspTree& tree) {
 }
 
 BspTree read_bsp_sections(const TreeFileReader& r, const TriangleSoup& soup) {
-  const std::vector<BspHeaderRecord> hv = r.array<BspHeaderRecord>(kBspHeaderTag);
-  if (hv.size() != 1) throw InputError(r.path(), "section BHDR must hold exactly one record");
-  const BspHeaderRecord& h = hv[0];
+  const BspHeaderRecord h = r.record<BspHeaderRecord>(kBspHeaderTag);
   Box3f box;
   for (int a = 0; a < 3; ++a) {
     if (!(std::isfinite(h.root_lo[a]) && std::isfinite(h.root_hi[a]) && h.root_lo[a] < h.root_hi[a]))

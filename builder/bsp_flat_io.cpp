@@ -30,9 +30,7 @@ bool has_flat_bsp_sections(const TreeFileReader& r) {
 }
 
 FlatBspTree read_flat_bsp_sections(const TreeFileReader& r, const TriangleSoup& soup) {
-  const std::vector<FlatBspHeaderRecord> hv = r.array<FlatBspHeaderRecord>(kFlatBspHeaderTag);
-  if (hv.size() != 1) throw InputError(r.path(), "section FHDR has the wrong size");
-  const FlatBspHeaderRecord& h = hv[0];
+  const FlatBspHeaderRecord h = r.record<FlatBspHeaderRecord>(kFlatBspHeaderTag);
   if (h.version != kFlatBspVersion)
     throw InputError(r.path(), "flat BSP layout version " + std::to_string(h.version) +
                                    ", expected " + std::to_string(kFlatBspVersion));

@@ -6,7 +6,7 @@
 ///
 /// Sections (little-endian, verbatim structs):
 ///   FHDR  FlatBspHeaderRecord (32 bytes)
-///   FNOD  FlatBspNode[]       (32 bytes each, node 0 = root, layout in bsp_node.h)
+///   FNOD  FlatBspNode[]       (16-byte slots, node 0 = root; a plane node takes two, layout in bsp_node.h)
 ///   FPRM  uint32[]            leaf triangle lists, concatenated
 
 #include <cstdint>

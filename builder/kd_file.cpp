@@ -28,13 +28,6 @@ struct BoundsRecord {
 };
 static_assert(sizeof(BoundsRecord) == 24);
 
-template <typename T>
-T single(const TreeFileReader& r, std::uint32_t tag) {
-  const std::vector<T> v = r.array<T>(tag);
-  if (v.size() != 1) throw InputError(r.path(), "section " + tree_tag_name(tag) + " has the wrong size");
-  return v[0];
-}
-
 }  // namespace
 
 void write_kd_tree(const std::string& path, const KdTree& tree, const TriangleSoup& soup,
@@ -64,14 +57,19 @@ KdTree read_kd_tree(const TreeFileReader& r, const TriangleSoup& soup, KdConfig*
   const std::string& path = r.path();
   if (r.kind() != TreeKind::Kd) throw InputError(path, "not a kd tree file (it holds another tree kind)");
   r.check_scene(soup);
+  return read_kd_sections(r, std::uint32_t(soup.size()), config);
+}
+
+KdTree read_kd_sections(const TreeFileReader& r, std::uint32_t triangle_count, KdConfig* config) {
+  const std::string& path = r.path();
   KdTree tree;
-  tree.triangle_count = std::uint32_t(soup.size());
+  tree.triangle_count = triangle_count;
   tree.nodes = r.array<KdNode>(kKdNodesTag);
   tree.prims = r.array<std::uint32_t>(kKdPrimsTag);
-  const BoundsRecord b = single<BoundsRecord>(r, kKdBoundsTag);
+  const BoundsRecord b = r.record<BoundsRecord>(kKdBoundsTag);
   tree.bounds.lo = {b.lo[0], b.lo[1], b.lo[2]};
   tree.bounds.hi = {b.hi[0], b.hi[1], b.hi[2]};
-  const ConfigRecord c = single<ConfigRecord>(r, kKdConfigTag);
+  const ConfigRecord c = r.record<ConfigRecord>(kKdConfigTag);
   if (config) {
     *config = KdConfig{c.traversal_cost, c.intersection_cost, c.empty_bonus, c.max_depth,
                        c.leaf_size,      c.parallel_threshold, c.perfect_splits != 0};

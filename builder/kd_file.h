@@ -27,6 +27,10 @@ void write_kd_tree(const std::string& path, const KdTree& tree, const TriangleSo
 /// holds a tree that fails KdTree::validate() or is too deep to traverse.
 KdTree read_kd_tree(const std::string& path, const TriangleSoup& soup, KdConfig* config = nullptr);
 
+/// The kd sections of `file` as a validated tree over `triangle_count`
+/// triangles, without the scene check (`bsprt stats` has no scene).
+KdTree read_kd_sections(const TreeFileReader& file, std::uint32_t triangle_count, KdConfig* config = nullptr);
+
 /// read_kd_tree on a file already opened (or held in memory).
 KdTree read_kd_tree(const TreeFileReader& file, const TriangleSoup& soup, KdConfig* config = nullptr);
 

@@ -13,7 +13,7 @@ namespace {
 
 constexpr char kMagic[8] = {'B', 'S', 'P', 'R', 'T', 'R', 'E', 'E'};
 constexpr std::size_t kHeaderSize = 40;
-constexpr std::size_t kCrcStart = 40;
+constexpr std::size_t kCrcField = 36;  // the CRC's own 4 bytes, the only ones it does not cover
 constexpr std::size_t kSectionHeader = 16;
 
 std::size_t padded(std::size_t n) { return (n + 7) & ~std::size_t(7); }
@@ -32,13 +32,9 @@ T get(const std::vector<std::byte>& in, std::size_t at) {
   return value;
 }
 
-std::uint32_t crc32(const std::byte* data, std::size_t n) {
-  boost::crc_32_type crc;
-  crc.process_bytes(data, n);
-  return crc.checksum();
-}
+}  // namespace
 
-std::vector<std::byte> read_all(const std::string& path) {
+std::vector<std::byte> read_tree_file_image(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot open tree file");
   std::vector<char> chars((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -48,7 +44,13 @@ std::vector<std::byte> read_all(const std::string& path) {
   return bytes;
 }
 
-}  // namespace
+std::uint32_t tree_file_crc(std::span<const std::byte> file, std::uint32_t version) {
+  if (file.size() < kHeaderSize) throw UsageError("tree_file_crc: a tree file has at least 40 bytes");
+  boost::crc_32_type crc;
+  if (version >= 2) crc.process_bytes(file.data(), kCrcField);
+  crc.process_bytes(file.data() + kHeaderSize, file.size() - kHeaderSize);
+  return crc.checksum();
+}
 
 std::string tree_tag_name(std::uint32_t tag) {
   std::string s = "'";
@@ -107,8 +109,8 @@ std::vector<std::byte> TreeFileWriter::bytes() const {
     out.insert(out.end(), bytes.begin(), bytes.end());
     out.resize(padded(out.size()), std::byte{0});
   }
-  const std::uint32_t crc = crc32(out.data() + kCrcStart, out.size() - kCrcStart);
-  std::memcpy(out.data() + 36, &crc, 4);
+  const std::uint32_t crc = tree_file_crc(out, kTreeFileVersion);
+  std::memcpy(out.data() + kCrcField, &crc, 4);
   return out;
 }
 
@@ -121,16 +123,19 @@ void TreeFileWriter::write(const std::string& path) const {
   if (!f) throw InputError(path, "cannot write tree file");
 }
 
-TreeFileReader::TreeFileReader(const std::string& path) : TreeFileReader(path, read_all(path)) {}
+TreeFileReader::TreeFileReader(const std::string& path) : TreeFileReader(path, read_tree_file_image(path)) {}
 
 TreeFileReader::TreeFileReader(const std::string& path, const std::vector<std::byte>& in) : path_(path) {
   if (in.size() < kHeaderSize)
     throw InputError(path, "truncated tree file: " + std::to_string(in.size()) + " bytes, header needs 40");
   if (std::memcmp(in.data(), kMagic, 8) != 0) throw InputError(path, "not a bsprt tree file (bad magic)");
   const auto version = get<std::uint32_t>(in, 8);
-  if (version != kTreeFileVersion)
+  if (version != kTreeFileVersion && version != 1)
     throw InputError(path, "tree file version " + std::to_string(version) + ", expected " +
-                               std::to_string(kTreeFileVersion));
+                               std::to_string(kTreeFileVersion) + " (or 1)");
+  version_ = version;
+  if (get<std::uint32_t>(in, kCrcField) != tree_file_crc(in, version))
+    throw InputError(path, "corrupt tree file (CRC mismatch) or truncated");
   const auto kind = get<std::uint32_t>(in, 12);
   if (kind != std::uint32_t(TreeKind::Kd) && kind != std::uint32_t(TreeKind::Bsp))
     throw InputError(path, "unknown tree kind " + std::to_string(kind));
@@ -138,8 +143,6 @@ TreeFileReader::TreeFileReader(const std::string& path, const std::vector<std::b
   fingerprint_ = get<std::uint64_t>(in, 16);
   triangle_count_ = get<std::uint64_t>(in, 24);
   const auto count = get<std::uint32_t>(in, 32);
-  if (get<std::uint32_t>(in, 36) != crc32(in.data() + kCrcStart, in.size() - kCrcStart))
-    throw InputError(path, "corrupt tree file (CRC mismatch) or truncated");
   std::size_t at = kHeaderSize;
   for (std::uint32_t i = 0; i < count; ++i) {
     if (in.size() - at < kSectionHeader)

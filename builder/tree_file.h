@@ -1,7 +1,7 @@
 #pragma once
 /// \file tree_file.h
 /// The container every tree file uses (kd and BSP): a versioned header, tagged
-/// sections, a CRC-32 over everything after the header's checksum field, and a
+/// sections, a CRC-32 over every byte but its own field (header included), and a
 /// fingerprint of the scene's triangle data so a tree cannot be used with
 /// another scene. Layout (little-endian):
 ///
@@ -12,7 +12,7 @@
 ///   16      8     scene fingerprint (scene_fingerprint)
 ///   24      8     triangle count of the scene
 ///   32      4     section count S
-///   36      4     CRC-32 of bytes [40, end)
+///   36      4     CRC-32 of bytes [0, 36) then [40, end) (version 1: [40, end) only)
 ///   40      S x { uint32 tag; uint32 reserved; uint64 size; size bytes; pad to 8 }
 
 #include <cstddef>
@@ -30,13 +30,20 @@
 
 namespace bsprt {
 
-inline constexpr std::uint32_t kTreeFileVersion = 1;
+/// Version written. Version 1 files (CRC not covering the header) are still read.
+inline constexpr std::uint32_t kTreeFileVersion = 2;
 
 /// A section tag from four characters, e.g. tree_tag("KNOD") (first char in the lowest byte).
 constexpr std::uint32_t tree_tag(const char (&s)[5]) {
   return std::uint32_t(std::uint8_t(s[0])) | std::uint32_t(std::uint8_t(s[1])) << 8 |
          std::uint32_t(std::uint8_t(s[2])) << 16 | std::uint32_t(std::uint8_t(s[3])) << 24;
 }
+/// The CRC-32 a tree file of `version` stores at offset 36. Version 2 (and
+/// later): every byte but the CRC field, header included. Version 1 covered only
+/// [40, end), so its header's fingerprint and triangle count went unchecked
+/// (`bsprt stats` printed a corrupt count; regression test in test_regressions.cpp).
+std::uint32_t tree_file_crc(std::span<const std::byte> file, std::uint32_t version);
+
 /// The four characters of a tag, for messages.
 std::string tree_tag_name(std::uint32_t tag);
 
@@ -76,6 +83,8 @@ class TreeFileReader {
   /// it in messages.
   TreeFileReader(const std::string& path, const std::vector<std::byte>& image);
   TreeKind kind() const { return kind_; }
+  /// The file's format version (1: its header is not covered by the CRC).
+  std::uint32_t version() const { return version_; }
   /// Triangle count of the scene the tree was built for.
   std::uint64_t triangle_count() const { return triangle_count_; }
   const std::string& path() const { return path_; }
@@ -90,9 +99,13 @@ class TreeFileReader {
   /// multiple of sizeof(T).
   template <typename T>
   std::vector<T> array(std::uint32_t tag) const;
+  /// A section holding exactly one T; throws InputError otherwise.
+  template <typename T>
+  T record(std::uint32_t tag) const;
 
  private:
   std::string path_;
+  std::uint32_t version_ = 0;
   TreeKind kind_{};
   std::uint64_t fingerprint_ = 0;
   std::uint64_t triangle_count_ = 0;
@@ -110,5 +123,17 @@ std::vector<T> TreeFileReader::array(std::uint32_t tag) const {
   if (!v.empty()) std::memcpy(v.data(), bytes.data(), bytes.size());
   return v;
 }
+
+template <typename T>
+T TreeFileReader::record(std::uint32_t tag) const {
+  const std::vector<T> v = array<T>(tag);
+  if (v.size() != 1)
+    throw InputError(path_, "section " + tree_tag_name(tag) + " must hold exactly one " + std::to_string(sizeof(T)) +
+                                "-byte record, it has " + std::to_string(v.size() * sizeof(T)) + " bytes");
+  return v[0];
+}
+
+/// The whole file at `path` (throws InputError when it cannot be read).
+std::vector<std::byte> read_tree_file_image(const std::string& path);
 
 }  // namespace bsprt

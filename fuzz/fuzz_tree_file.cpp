@@ -7,7 +7,7 @@
 // shorter than the 40-byte header are read as they are).
 #include <unistd.h>
 
-#include <boost/crc.hpp>
+#include <span>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -41,9 +41,9 @@ std::vector<std::uint8_t> patched(const std::uint8_t* data, std::size_t size) {
   if (b.size() < 40) return b;
   put_u64(b, 16, bsprt::scene_fingerprint(scene()));
   put_u64(b, 24, scene().size());
-  boost::crc_32_type crc;
-  crc.process_bytes(b.data() + 40, b.size() - 40);
-  const std::uint32_t c = crc.checksum();
+  std::uint32_t version;
+  std::memcpy(&version, b.data() + 8, 4);
+  const std::uint32_t c = bsprt::tree_file_crc(std::as_bytes(std::span(b)), version);
   std::memcpy(b.data() + 36, &c, 4);
   return b;
 }

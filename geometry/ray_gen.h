@@ -35,7 +35,7 @@ std::vector<Ray> random_rays(const TriangleSoup& soup, std::size_t n, std::uint6
 
 /// `n` rays from random origins (as random_rays) aimed at vertices of random
 /// non-degenerate triangles: dir = vertex - origin in float, so the exact ray
-/// passes within one rounding of the vertex — the stiff case of DESIGN.md.
+/// passes within one rounding of the vertex — the stiff case of docs/robustness.md.
 std::vector<Ray> vertex_rays(const TriangleSoup& soup, std::size_t n, std::uint64_t seed);
 
 /// `n` rays from random origins aimed at random points of random triangle edges.

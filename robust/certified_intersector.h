@@ -1,8 +1,8 @@
 #pragma once
 /// \file certified_intersector.h
 /// Ray/triangle tests whose every decision is exact: hit or miss, t inside
-/// [tnear, tfar], and which of two hits is nearer. Filtered (DESIGN.md,
-/// "exactness where it matters"): interval arithmetic (CGAL::Interval_nt)
+/// [tnear, tfar], and which of two hits is nearer. Filtered (docs/bsp-build.md,
+/// "Exact arithmetic scheme"): interval arithmetic (CGAL::Interval_nt)
 /// decides almost always; exact rationals (CGAL::Exact_rational) run only when
 /// an interval straddles zero, and are counted.
 ///

@@ -1,7 +1,7 @@
 #pragma once
 /// \file exact_side.h
-/// Exact points and exact side-of-plane tests (DESIGN.md "Exactness where it
-/// matters"). A point is the intersection of three stored planes (plane.h), so
+/// Exact points and exact side-of-plane tests (docs/bsp-build.md "Exact
+/// arithmetic scheme"). A point is the intersection of three stored planes (plane.h), so
 /// its exact coordinates are rational functions of the input floats and no
 /// construction depends on an earlier construction. Each point carries an
 /// interval enclosure of its coordinates; a side test first evaluates the plane

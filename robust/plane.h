@@ -1,7 +1,7 @@
 #pragma once
 /// \file plane.h
-/// Planes stored by the input data that defines them (DESIGN.md "Exactness where
-/// it matters"; Ize, Wald, Parker, "Ray Tracing with the BSP Tree", RT 2008, §3:
+/// Planes stored by the input data that defines them (docs/bsp-build.md "Exact
+/// arithmetic scheme"; Ize, Wald, Parker, "Ray Tracing with the BSP Tree", RT 2008, §3:
 /// the candidate planes are a triangle's face plane, the planes through its edges
 /// orthogonal to the face, and axis-aligned planes). A PlaneDef never holds a
 /// rounded coefficient: its exact coefficients are polynomials in the scene's

@@ -3,8 +3,6 @@
 // BSP (float and certified leaves, without and with a box top) once per scene, trace ray sets with every
 // mode, compare with the exact reference, and optionally append the figures
 // to a Markdown table (BSPRT_ROBUSTNESS_REPORT=path) for docs/robustness.md.
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -20,6 +18,7 @@
 #include "bsprt/ray.h"
 #include "geometry/triangle_soup.h"
 #include "traverse/bsp_traverse.h"
+#include "traverse/trace_parallel.h"
 
 namespace bsprt::test {
 
@@ -51,9 +50,9 @@ struct ModeSet {
 /// Traces `rays` with `t` (in parallel over TBB).
 inline std::vector<Hit> trace_all(const Accelerator& t, const std::vector<Ray>& rays) {
   std::vector<Hit> hits(rays.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
-    for (std::size_t i = r.begin(); i < r.end(); ++i) hits[i] = t.trace(rays[i]);
-  });
+  ParallelTrace o;
+  o.block = 256;
+  trace_parallel(t, rays, hits, o);
   return hits;
 }
 

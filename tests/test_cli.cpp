@@ -317,3 +317,35 @@ TEST_CASE("trace --accel embree refuses a ray Embree cannot trace with its numbe
   CHECK(kd.status == 0);
   CHECK(read_hits(out).size() == 3);
 }
+
+// Regression (issue #22 item 5): version 1 tree files left the header out of
+// the CRC, so `bsprt stats` of a suzanne tree with byte 30 flipped printed
+// "BSP tree for 71776119061218248 triangles" and exited 0. Every byte but the
+// CRC field is covered now: stats, trace and verify all reject such a file.
+TEST_CASE("stats and trace and verify reject a tree file whose header is corrupt", "[cli][regression]") {
+  const std::string scene = test::scene_path("suzanne.obj");
+  for (const char* accel : {"bsp", "kd"}) {
+    const std::string tree = test::temp_path(std::string("header-corrupt.") + accel + ".tree");
+    REQUIRE(test::bsprt_cli("build " + scene + " --accel " + accel + " -o " + tree).status == 0);
+    const test::CliRun ok = test::bsprt_cli("stats " + tree);
+    REQUIRE(ok.status == 0);
+    CHECK((ok.output.find("968 triangles") != std::string::npos || ok.output.find("kd-tree") != std::string::npos));
+    std::vector<char> bytes;
+    {
+      std::ifstream in(tree, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    for (int at : {12, 20, 30}) {  // kind, fingerprint, triangle count
+      std::vector<char> bad = bytes;
+      bad[std::size_t(at)] ^= 0x01;
+      const std::string path = test::temp_path(std::string("header-corrupt-") + std::to_string(at) + "." + accel + ".tree");
+      std::ofstream(path, std::ios::binary).write(bad.data(), std::streamsize(bad.size()));
+      const test::CliRun stats = test::bsprt_cli("stats " + path);
+      INFO(accel << " byte " << at << ": " << stats.output);
+      CHECK(stats.status == 1);
+      CHECK(stats.output.find(path) != std::string::npos);
+      CHECK(stats.output.find("triangles") == std::string::npos);  // nothing printed from the bad header
+      CHECK(test::bsprt_cli("verify " + scene + " " + path).status == 1);
+    }
+  }
+}

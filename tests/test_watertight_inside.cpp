@@ -52,9 +52,9 @@ std::size_t count_leaks(const Accelerator& t, const ClosedCase& c, std::size_t n
   for (std::size_t done = 0, chunk = 0; done < n; done += kChunk, ++chunk) {
     const std::vector<Ray> rays = inside_rays(c.soup, c.inside, c.radius, std::min(kChunk, n - done), 77 + chunk);
     std::atomic<std::size_t> misses{0};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& r) {
+    for_each_block(rays.size(), 1024, [&](std::size_t b, std::size_t e) {
       std::size_t m = 0;
-      for (std::size_t i = r.begin(); i < r.end(); ++i) m += t.trace(rays[i]).hit() ? 0 : 1;
+      for (std::size_t i = b; i < e; ++i) m += t.trace(rays[i]).hit() ? 0 : 1;
       misses += m;
     });
     leaks += misses;

@@ -11,7 +11,7 @@
 ///  - a subtree that lists no triangle (an empty leaf, or splits over empty
 ///    leaves only) is not stored: its parent carries an "empty" bit for that
 ///    child, so traversal neither fetches nor stacks it. Visiting it could not
-///    find a hit (DESIGN.md: leave out what the scene does not need).
+///    find a hit (README: leave out what the scene does not need).
 ///
 /// Slot layout (two little-endian uint32 words, `head` and `word`):
 ///
