@@ -7,9 +7,9 @@
 #include <string>
 
 #include "builder/tree_file.h"
-#include "geometry/default_scene.h"
-#include "geometry/load_mesh.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/scenes/default_scene.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/core/triangle_soup.h"
 #include "robust/degenerate.h"
 
 namespace bsprt {

@@ -9,14 +9,14 @@
 #include <fstream>
 #include <mutex>
 
-#include "builder/bsp_build.h"
-#include "builder/bsp_flat_io.h"
-#include "builder/bsp_flatten.h"
-#include "builder/kd_build.h"
-#include "builder/kd_file.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_flat_io.h"
+#include "builder/bsp/bsp_flatten.h"
+#include "builder/kd/kd_build.h"
+#include "builder/kd/kd_file.h"
 #include "builder/tree_file.h"
-#include "builder/verify_file.h"
-#include "robust/verify.h"
+#include "verify/verify_file.h"
+#include "verify/verify.h"
 
 namespace bsprt {
 

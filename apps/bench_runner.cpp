@@ -18,16 +18,16 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include "builder/accel_factory.h"
-#include "builder/bsp_build.h"
-#include "builder/bsp_flat_io.h"
-#include "builder/bsp_flatten.h"
-#include "geometry/camera.h"
-#include "geometry/default_scene.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_flat_io.h"
+#include "builder/bsp/bsp_flatten.h"
+#include "geometry/scenes/camera.h"
+#include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
-#include "geometry/load_mesh.h"
-#include "geometry/ray_gen.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/scenes/ray_gen.h"
 #include "robust/exact_tracer.h"
-#include "traverse/cpu_features.h"
+#include "traverse/simd/cpu_features.h"
 #include "traverse/trace_parallel.h"
 
 namespace bsprt {

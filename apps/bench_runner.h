@@ -19,7 +19,7 @@
 #include "bsprt/ray.h"
 #include "traverse/counters.h"
 #include "traverse/accelerator.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "bsprt/vec3.h"
 
 namespace bsprt {

@@ -5,7 +5,7 @@
 #include <fmt/core.h>
 
 #include "apps/progress.h"
-#include "geometry/default_scene.h"
+#include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
 
 namespace bsprt::cli {

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "builder/accel_factory.h"
-#include "geometry/load_mesh.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/core/triangle_soup.h"
 
 namespace bsprt::cli {
 

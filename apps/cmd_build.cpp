@@ -8,15 +8,15 @@
 
 #include "apps/cli_common.h"
 #include "apps/progress.h"
-#include "builder/bsp_build.h"
-#include "builder/bsp_file.h"
-#include "builder/bsp_flat_io.h"
-#include "builder/bsp_flatten.h"
-#include "builder/kd_build.h"
-#include "builder/kd_file.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_file.h"
+#include "builder/bsp/bsp_flat_io.h"
+#include "builder/bsp/bsp_flatten.h"
+#include "builder/kd/kd_build.h"
+#include "builder/kd/kd_file.h"
 #include "builder/tree_file.h"
 #include "bsprt/error.h"
-#include "traverse/bsp_node.h"
+#include "traverse/bsp/bsp_node.h"
 
 namespace bsprt::cli {
 namespace {

@@ -10,8 +10,8 @@
 #include "apps/cli_common.h"
 #include "bsprt/error.h"
 #include "bsprt/io.h"
-#include "geometry/stiff_rays.h"
-#include "geometry/stiff_scenes.h"
+#include "geometry/scenes/stiff_rays.h"
+#include "geometry/scenes/stiff_scenes.h"
 
 namespace bsprt::cli {
 namespace {

@@ -5,8 +5,8 @@
 #include <memory>
 
 #include "apps/cli_common.h"
-#include "geometry/default_scene.h"
-#include "geometry/ray_gen.h"
+#include "geometry/scenes/default_scene.h"
+#include "geometry/scenes/ray_gen.h"
 #include "bsprt/io.h"
 
 namespace bsprt::cli {

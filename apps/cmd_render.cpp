@@ -11,7 +11,7 @@
 #include "apps/path_tracer.h"
 #include "apps/progress.h"
 #include "apps/render.h"
-#include "geometry/default_scene.h"
+#include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
 
 namespace bsprt::cli {

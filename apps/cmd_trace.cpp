@@ -11,12 +11,12 @@
 
 #include "apps/cli_common.h"
 #include "apps/progress.h"
-#include "builder/bsp_face_hits.h"
-#include "builder/bsp_file.h"
+#include "builder/bsp/bsp_face_hits.h"
+#include "builder/bsp/bsp_file.h"
 #include "builder/tree_file.h"
 #include "bsprt/error.h"
 #include "bsprt/io.h"
-#include "traverse/embree_tracer.h"
+#include "traverse/embree/embree_tracer.h"
 #include "traverse/trace_parallel.h"
 
 namespace bsprt::cli {

@@ -9,11 +9,11 @@
 
 #include "apps/cli_common.h"
 #include "apps/progress.h"
-#include "builder/kd_build.h"
-#include "builder/kd_file.h"
+#include "builder/kd/kd_build.h"
+#include "builder/kd/kd_file.h"
 #include "builder/tree_file.h"
-#include "builder/verify_file.h"
-#include "robust/verify.h"
+#include "verify/verify_file.h"
+#include "verify/verify.h"
 
 namespace bsprt::cli {
 namespace {

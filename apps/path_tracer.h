@@ -13,8 +13,8 @@
 
 #include "apps/image_io.h"
 #include "apps/render.h"
-#include "geometry/camera.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/scenes/camera.h"
+#include "geometry/core/triangle_soup.h"
 #include "traverse/accelerator.h"
 
 namespace bsprt {

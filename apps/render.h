@@ -7,8 +7,8 @@
 #include <functional>
 
 #include "apps/image_io.h"
-#include "geometry/camera.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/scenes/camera.h"
+#include "geometry/core/triangle_soup.h"
 #include "traverse/counters.h"
 #include "traverse/accelerator.h"
 

@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "builder/bsp_build.h"
-#include "builder/kd_build.h"
-#include "geometry/load_mesh.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/kd/kd_build.h"
+#include "geometry/io/load_mesh.h"
 
 namespace {
 

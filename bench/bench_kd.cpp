@@ -17,13 +17,13 @@
 #include <oneapi/tbb/parallel_for.h>
 
 #include "apps/bench_runner.h"
-#include "builder/kd_build.h"
-#include "geometry/camera.h"
-#include "geometry/load_mesh.h"
-#include "geometry/ray_gen.h"
-#include "traverse/cpu_features.h"
-#include "traverse/embree_tracer.h"
-#include "traverse/kd_traverse.h"
+#include "builder/kd/kd_build.h"
+#include "geometry/scenes/camera.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/scenes/ray_gen.h"
+#include "traverse/simd/cpu_features.h"
+#include "traverse/embree/embree_tracer.h"
+#include "traverse/kd/kd_traverse.h"
 
 using namespace bsprt;
 

@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "builder/kd_build.h"
-#include "geometry/load_mesh.h"
-#include "geometry/ray_gen.h"
-#include "traverse/kd_traverse.h"
+#include "builder/kd/kd_build.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/scenes/ray_gen.h"
+#include "traverse/kd/kd_traverse.h"
 #include "traverse/watertight.h"
 
 namespace {

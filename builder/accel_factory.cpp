@@ -4,20 +4,21 @@
 
 #include <oneapi/tbb/task_arena.h>
 
-#include "builder/bsp_build.h"
-#include "builder/bsp_file.h"
-#include "builder/bsp_flat_io.h"
-#include "builder/bsp_flatten.h"
-#include "builder/kd_build.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_file.h"
+#include "builder/bsp/bsp_flat_io.h"
+#include "builder/bsp/bsp_flatten.h"
+#include "builder/kd/kd_build.h"
 #include "builder/tree_file.h"
-#include "builder/kd_file.h"
+#include "builder/kd/kd_file.h"
 #include "bsprt/error.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 #include "traverse/brute_force.h"
-#include "traverse/embree_tracer.h"
-#include "traverse/bsp_traverse.h"
-#include "traverse/kd_traverse.h"
+#include "traverse/embree/embree_tracer.h"
+#include "traverse/bsp/bsp_traverse.h"
+#include "traverse/embree/box_top_build.h"
+#include "traverse/kd/kd_traverse.h"
 
 namespace bsprt {
 namespace {

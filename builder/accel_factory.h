@@ -13,12 +13,12 @@
 #include <string_view>
 #include <vector>
 
-#include "builder/bsp_config.h"
+#include "builder/bsp/bsp_config.h"
 #include "builder/tree_file.h"
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "traverse/accelerator.h"
-#include "traverse/bsp_traverse.h"
+#include "traverse/bsp/bsp_traverse.h"
 
 namespace bsprt {
 

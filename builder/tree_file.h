@@ -26,7 +26,7 @@
 
 #include "bsprt/error.h"
 #include "bsprt/tree_kind.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 
 namespace bsprt {
 

@@ -26,8 +26,8 @@
 #include "builder/accel_factory.h"
 #include "bsprt/compare.h"
 #include "robust/degenerate.h"
-#include "traverse/bsp_traverse.h"
-#include "traverse/cpu_features.h"
+#include "traverse/bsp/bsp_traverse.h"
+#include "traverse/simd/cpu_features.h"
 
 namespace {
 

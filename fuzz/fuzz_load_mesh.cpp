@@ -10,7 +10,7 @@
 #include <string>
 
 #include "bsprt/error.h"
-#include "geometry/load_mesh.h"
+#include "geometry/io/load_mesh.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;

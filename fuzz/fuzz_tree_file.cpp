@@ -17,14 +17,14 @@
 #include <vector>
 
 #include "builder/accel_factory.h"
-#include "builder/bsp_build.h"
-#include "builder/bsp_file.h"
-#include "builder/kd_build.h"
-#include "builder/kd_file.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_file.h"
+#include "builder/kd/kd_build.h"
+#include "builder/kd/kd_file.h"
 #include "builder/tree_file.h"
-#include "geometry/default_scene.h"
+#include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
-#include "geometry/ray_gen.h"
+#include "geometry/scenes/ray_gen.h"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "geometry/check.h"
+#include "geometry/core/check.h"
 
 namespace bsprt {
 

@@ -19,7 +19,7 @@
 
 #include <vector>
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "bsprt/vec3.h"
 #include "robust/exact_side.h"
 #include "robust/plane.h"

@@ -17,7 +17,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "traverse/leaf_intersector.h"
 #include "traverse/accelerator.h"
 

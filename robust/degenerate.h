@@ -6,7 +6,7 @@
 
 #include <cstddef>
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 
 namespace bsprt {
 

@@ -9,7 +9,7 @@
 
 #include <cmath>
 
-#include "geometry/check.h"
+#include "geometry/core/check.h"
 #include "robust/exact_side.h"
 
 namespace bsprt {

@@ -16,7 +16,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "robust/exact_side.h"
 
 namespace bsprt {

@@ -6,7 +6,7 @@
 /// interval contains 0.
 #include <CGAL/Interval_nt.h>
 
-#include "geometry/check.h"
+#include "geometry/core/check.h"
 #include "robust/exact_side.h"
 
 namespace bsprt {

@@ -16,7 +16,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "bsprt/vec3.h"
 #include "robust/plane.h"
 

@@ -10,7 +10,7 @@
 
 #include <memory>
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "traverse/accelerator.h"
 
 namespace bsprt {

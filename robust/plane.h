@@ -20,7 +20,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "bsprt/vec3.h"
 
 namespace bsprt {

@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "builder/bsp_build.h"
-#include "builder/bsp_flatten.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_flatten.h"
 #include "bsprt/ray.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "robust/degenerate.h"
 #include "traverse/brute_force.h"
-#include "traverse/bsp_traverse.h"
+#include "traverse/bsp/bsp_traverse.h"
 
 namespace bsprt::test {
 

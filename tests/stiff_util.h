@@ -11,13 +11,13 @@
 #include <vector>
 
 #include "builder/accel_factory.h"
-#include "builder/bsp_build.h"
-#include "builder/bsp_flat_io.h"
-#include "builder/bsp_flatten.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_flat_io.h"
+#include "builder/bsp/bsp_flatten.h"
 #include "bsprt/compare.h"
 #include "bsprt/ray.h"
-#include "geometry/triangle_soup.h"
-#include "traverse/bsp_traverse.h"
+#include "geometry/core/triangle_soup.h"
+#include "traverse/bsp/bsp_traverse.h"
 #include "traverse/trace_parallel.h"
 
 namespace bsprt::test {

@@ -10,14 +10,14 @@
 #include <vector>
 
 #include "bsprt/error.h"
-#include "geometry/load_mesh.h"
+#include "geometry/io/load_mesh.h"
 #include "bsprt/ray.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "test_util.h"
 #include "traverse/brute_force.h"
-#include "traverse/cpu_features.h"
-#include "traverse/embree_tracer.h"
-#include "traverse/watertight_packet_brute.h"
+#include "traverse/simd/cpu_features.h"
+#include "traverse/embree/embree_tracer.h"
+#include "traverse/simd/watertight_packet_brute.h"
 
 using namespace bsprt;
 

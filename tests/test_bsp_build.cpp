@@ -21,11 +21,11 @@
 #include <sstream>
 #include <string>
 
-#include "builder/bsp_build.h"
-#include "builder/bsp_candidates.h"
-#include "builder/bsp_file.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_candidates.h"
+#include "builder/bsp/bsp_file.h"
 #include "bsprt/error.h"
-#include "geometry/load_mesh.h"
+#include "geometry/io/load_mesh.h"
 #include "test_util.h"
 
 namespace {

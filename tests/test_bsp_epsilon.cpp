@@ -13,8 +13,8 @@
 #include <tuple>
 
 #include "bsp_test_util.h"
-#include "geometry/default_scene.h"
-#include "geometry/load_mesh.h"
+#include "geometry/scenes/default_scene.h"
+#include "geometry/io/load_mesh.h"
 #include "test_util.h"
 
 using namespace bsprt;

@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "bsp_test_util.h"
-#include "builder/bsp_face_hits.h"
-#include "geometry/load_mesh.h"
+#include "builder/bsp/bsp_face_hits.h"
+#include "geometry/io/load_mesh.h"
 #include "robust/degenerate.h"
 #include "test_util.h"
 

@@ -19,15 +19,16 @@
 
 #include "bsp_test_util.h"
 #include "builder/accel_factory.h"
-#include "builder/bsp_flat_io.h"
-#include "builder/kd_build.h"
-#include "geometry/default_scene.h"
+#include "builder/bsp/bsp_flat_io.h"
+#include "builder/kd/kd_build.h"
+#include "geometry/scenes/default_scene.h"
 #include "bsprt/compare.h"
-#include "geometry/load_mesh.h"
-#include "geometry/ray_gen.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/scenes/ray_gen.h"
 #include "test_util.h"
-#include "traverse/cpu_features.h"
-#include "traverse/kd_traverse.h"
+#include "traverse/simd/cpu_features.h"
+#include "traverse/embree/box_top_build.h"
+#include "traverse/kd/kd_traverse.h"
 
 using namespace bsprt;
 using namespace bsprt::test;

@@ -5,9 +5,9 @@
 #include <map>
 #include <utility>
 
-#include "geometry/default_scene.h"
+#include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
-#include "geometry/ray_gen.h"
+#include "geometry/scenes/ray_gen.h"
 
 using namespace bsprt;
 

@@ -4,9 +4,9 @@
 // disagree with the exact answer.
 #include <catch2/catch.hpp>
 
-#include "geometry/default_scene.h"
-#include "geometry/load_mesh.h"
-#include "geometry/ray_gen.h"
+#include "geometry/scenes/default_scene.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/scenes/ray_gen.h"
 #include "robust/certified_intersector.h"
 #include "robust/degenerate.h"
 #include "robust/exact_tracer.h"

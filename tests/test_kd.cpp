@@ -15,17 +15,17 @@
 #include <vector>
 
 #include "builder/accel_factory.h"
-#include "builder/kd_build.h"
-#include "builder/kd_file.h"
+#include "builder/kd/kd_build.h"
+#include "builder/kd/kd_file.h"
 #include "bsprt/error.h"
-#include "geometry/load_mesh.h"
-#include "geometry/ray_gen.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/scenes/ray_gen.h"
 #include "robust/degenerate.h"
 #include "test_util.h"
 #include "traverse/brute_force.h"
-#include "traverse/cpu_features.h"
-#include "traverse/kd_traverse.h"
-#include "traverse/watertight_packet_brute.h"
+#include "traverse/simd/cpu_features.h"
+#include "traverse/kd/kd_traverse.h"
+#include "traverse/simd/watertight_packet_brute.h"
 
 using namespace bsprt;
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "bsprt/error.h"
-#include "geometry/load_mesh.h"
+#include "geometry/io/load_mesh.h"
 #include "robust/degenerate.h"
 #include "test_util.h"
 

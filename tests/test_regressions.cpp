@@ -6,9 +6,9 @@
 #include <limits>
 #include <utility>
 
-#include "geometry/default_scene.h"
+#include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
-#include "geometry/load_mesh.h"
+#include "geometry/io/load_mesh.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 #include "stiff_util.h"

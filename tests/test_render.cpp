@@ -11,12 +11,12 @@
 #include "apps/path_tracer.h"
 #include "apps/ray_offset.h"
 #include "apps/render.h"
-#include "geometry/default_scene.h"
+#include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
 #include "robust/degenerate.h"
 #include "traverse/brute_force.h"
 #include "builder/accel_factory.h"
-#include "traverse/embree_tracer.h"
+#include "traverse/embree/embree_tracer.h"
 
 using namespace bsprt;
 

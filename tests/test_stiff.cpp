@@ -15,10 +15,10 @@
 #include <optional>
 
 #include "bsprt/error.h"
-#include "geometry/load_mesh.h"
+#include "geometry/io/load_mesh.h"
 #include "bsprt/io.h"
-#include "geometry/stiff_rays.h"
-#include "geometry/stiff_scenes.h"
+#include "geometry/scenes/stiff_rays.h"
+#include "geometry/scenes/stiff_scenes.h"
 #include "stiff_util.h"
 
 using namespace bsprt;

@@ -10,15 +10,15 @@
 #include <string>
 #include <vector>
 
-#include "builder/bsp_build.h"
-#include "builder/bsp_file.h"
-#include "builder/bsp_flat_io.h"
-#include "builder/bsp_flatten.h"
-#include "builder/verify_file.h"
-#include "geometry/default_scene.h"
-#include "geometry/load_mesh.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_file.h"
+#include "builder/bsp/bsp_flat_io.h"
+#include "builder/bsp/bsp_flatten.h"
+#include "verify/verify_file.h"
+#include "geometry/scenes/default_scene.h"
+#include "geometry/io/load_mesh.h"
 #include "robust/degenerate.h"
-#include "robust/verify.h"
+#include "verify/verify.h"
 #include "test_util.h"
 
 using namespace bsprt;

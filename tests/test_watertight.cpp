@@ -12,11 +12,11 @@
 
 #include "bsprt/error.h"
 #include "bsprt/ray.h"
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "traverse/brute_force.h"
-#include "traverse/cpu_features.h"
+#include "traverse/simd/cpu_features.h"
 #include "traverse/watertight.h"
-#include "traverse/watertight_packet_brute.h"
+#include "traverse/simd/watertight_packet_brute.h"
 
 using namespace bsprt;
 

@@ -9,9 +9,9 @@
 
 #include <atomic>
 
-#include "geometry/default_scene.h"
-#include "geometry/stiff_rays.h"
-#include "geometry/stiff_scenes.h"
+#include "geometry/scenes/default_scene.h"
+#include "geometry/scenes/stiff_rays.h"
+#include "geometry/scenes/stiff_scenes.h"
 #include "stiff_util.h"
 
 using namespace bsprt;

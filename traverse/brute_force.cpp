@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "bsprt/error.h"
-#include "traverse/cpu_features.h"
+#include "traverse/simd/cpu_features.h"
 #include "traverse/watertight.h"
-#include "traverse/watertight_packet_brute.h"
+#include "traverse/simd/watertight_packet_brute.h"
 
 namespace bsprt {
 

@@ -3,9 +3,9 @@
 /// The brute-force oracle: tests every non-degenerate triangle with the
 /// watertight test. Slow and obviously right; the reference for tree tests.
 
-#include "geometry/triangle_soup.h"
+#include "geometry/core/triangle_soup.h"
 #include "traverse/accelerator.h"
-#include "traverse/watertight_packet_brute.h"
+#include "traverse/simd/watertight_packet_brute.h"
 
 namespace bsprt {
 

@@ -24,7 +24,7 @@
 #include <utility>
 
 #include "bsprt/ray.h"
-#include "traverse/simd.h"
+#include "traverse/simd/simd.h"
 
 namespace bsprt {
 

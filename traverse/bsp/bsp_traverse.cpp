@@ -1,0 +1,507 @@
+/// \file bsp_traverse.cpp
+/// Single-ray BSP traversal and the dispatcher of the packet kernels. Compiled
+/// with -ffp-contract=off: bsp_packet.inl repeats these steps bit for bit.
+#include "traverse/bsp/bsp_traverse.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstddef>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "bsprt/error.h"
+#include "traverse/bsp/bsp_kernel.h"
+#include "traverse/simd/cpu_features.h"
+#include "traverse/simd/simd.h"
+#include "traverse/watertight.h"
+
+namespace bsprt {
+namespace {
+
+using detail::BspRayConst;
+using detail::BspView;
+
+/// Entries of the box top's stack: three per level of Embree's maxDepth (64).
+constexpr int kTopStackSize = 3 * 64 + 4;
+
+/// A far child waiting on the stack with the ray's (conservative) interval.
+struct StackEntry {
+  std::uint32_t node;
+  float tmin, tmax;
+};
+
+/// Tests the triangles of a leaf (ties keep the earlier triangle). With an
+/// exact leaf test, `nearest` keeps the exact order and hit mirrors it.
+template <bool kCount>
+inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray& ray, const WatertightRay& wr,
+                           Hit& hit, NearestHit& nearest, RayCounters* c) {
+  const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
+  if constexpr (kCount) ++c->leaf_visits;
+  if (v.exact_leaf) {
+    v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, n.prim_count()), nearest,
+                            kCount ? c : nullptr);
+    hit = nearest.hit;
+    return;
+  }
+  if constexpr (kCount) c->triangle_tests += n.prim_count();
+  for (std::uint32_t i = first; i < end; ++i) {
+    const BspTriangle& t = v.triangles[i];
+    intersect_watertight_closest(wr, t.v[0], t.v[1], t.v[2], v.prims[i], hit);
+  }
+}
+
+/// One inner node: the near child's upper end and the far child's lower end
+/// of the ray interval, and whether near is the second child.
+template <bool kCount>
+inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near_hi, float& far_lo,
+                     RayCounters* c) {
+  if (n->is_plane()) {
+    if constexpr (kCount) ++c->bsp_node_visits;
+    const float b = detail::plane_cut<float>(n, rc.o, rc.dir, rc.err, near_hi, far_lo);
+    return b < 0.0f;
+  }
+  if constexpr (kCount) ++c->kd_node_visits;
+  const int k = n->axis();
+  detail::kd_cut<float>(n->split(), rc.o[k], rc.inv[k], near_hi, far_lo);
+  return rc.neg[k];
+}
+
+/// Front-to-back traversal (pbrt's kd-tree loop with the paper's BSP node
+/// step, made conservative) of the subtree at slot `root`, entered with the
+/// ray interval [tmin, tmax]. A child is culled when its conservative
+/// interval is empty (NaN crossings cull nothing) or when it lists no
+/// triangle (not stored, bsp_compact.h); a popped cell is skipped when it
+/// starts past the nearest hit. bsp_packet.inl repeats these steps.
+template <bool kCount>
+inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray& ray, const WatertightRay& wr,
+                             std::uint32_t root, float tmin, float tmax, Hit& hit, NearestHit& nearest,
+                             RayCounters* c) {
+  StackEntry stack[kBspMaxDepth];
+  int sp = 0;
+  std::uint32_t node = root;
+  float best = detail::hit_bound(rc, hit.t);  // hit.t in the traversal's parameter; changes at leaves only
+  for (;;) {
+    const CompactBspSlot* n = &v.nodes[node];
+    bool leaf = true;
+    while (!n->is_leaf()) {
+      // The first child follows this node; fetch the second while t is computed.
+      __builtin_prefetch(&v.nodes[n->second_child()]);
+      float near_hi, far_lo;
+      const bool flip = cut_node<kCount>(n, rc, near_hi, far_lo, c);
+      const std::uint32_t first = node + n->slots(), second = n->second_child();
+      const std::uint32_t near = flip ? second : first, far = flip ? first : second;
+      const bool near_empty = flip ? n->second_empty() : n->first_empty();
+      const bool far_empty = flip ? n->first_empty() : n->second_empty();
+      const bool go_near = !(near_hi < tmin) && !near_empty, go_far = !(far_lo > tmax) && !far_empty;  // NaN: both
+      if (go_far) {
+        const float far_min = far_lo > tmin ? far_lo : tmin;
+        if (go_near) {
+          stack[sp++] = {far, far_min, tmax};
+          node = near;
+          tmax = near_hi < tmax ? near_hi : tmax;
+        } else {
+          node = far;
+          tmin = far_min;
+        }
+      } else if (go_near) {
+        node = near;
+        tmax = near_hi < tmax ? near_hi : tmax;
+      } else {
+        leaf = false;
+        break;
+      }
+      n = &v.nodes[node];
+    }
+    if (leaf) {
+      intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
+      best = detail::hit_bound(rc, hit.t);
+    }
+    for (;;) {
+      if (sp == 0) return;
+      const StackEntry& e = stack[--sp];
+      if (e.tmin > best) continue;
+      node = e.node;
+      tmin = e.tmin;
+      tmax = e.tmax < best ? e.tmax : best;
+      break;
+    }
+  }
+}
+
+/// One ray: counts it, makes its constants, and unless it is invalid or
+/// misses the root box hands them to walk(rc, wr, hit, nearest).
+template <bool kCount, typename Walk>
+inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& walk) {
+  Hit hit;
+  if constexpr (kCount) ++c->rays;
+  const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
+  if (!rc.live) return hit;
+  const WatertightRay wr = watertight_precompute(ray);
+  NearestHit nearest;
+  walk(rc, wr, hit, nearest);
+  return hit;
+}
+
+/// One ray through the whole tree.
+template <bool kCount>
+Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
+  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const WatertightRay& wr, Hit& hit,
+                                          NearestHit& nearest) {
+    traverse_subtree<kCount>(v, rc, ray, wr, 0, rc.tmin, rc.tmax, hit, nearest, c);
+  });
+}
+
+/// The box top (bsp_boxtop.h), then the BSP subtrees whose boxes the ray
+/// enters, nearest box first. A box is entered with the ray's interval
+/// clipped to it by widened slab crossings (monotone, so widening the max/min
+/// equals widening each crossing as bsp_ray_setup does); a subtree then runs
+/// the certified steps from its root.
+template <bool kCount>
+inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayConst& rc, const Ray& ray,
+                     const WatertightRay& wr, Hit& hit, NearestHit& nearest, RayCounters* c) {
+  using V = simd::vfloat<4>;
+  struct Entry {
+    std::uint32_t ref;
+    float tmin, tmax;
+  };
+  Entry stack[kTopStackSize];
+  int sp = 0;
+  Entry cur{0, rc.tmin, rc.tmax};
+  // Offsets (in floats) of the entry and exit planes of axis k in a node:
+  // lo[k] is at 4k, hi[k] at 12 + 4k; a negative direction swaps them.
+  int near_off[3], far_off[3];
+  for (int k = 0; k < 3; ++k) {
+    near_off[k] = 4 * k + (rc.neg[k] ? 12 : 0);
+    far_off[k] = 4 * k + (rc.neg[k] ? 0 : 12);
+  }
+  static_assert(offsetof(BoxTopNode, hi) == 12 * sizeof(float));
+  const float inf = std::numeric_limits<float>::infinity();
+  float best = detail::hit_bound(rc, hit.t);  // the nearest hit in the traversal's parameter; changes in subtrees only
+  for (;;) {
+    if ((cur.ref & BoxTopNode::kSubtree) != 0) {
+      traverse_subtree<kCount>(v, rc, ray, wr, cur.ref & ~BoxTopNode::kSubtree, cur.tmin,
+                               cur.tmax < best ? cur.tmax : best, hit, nearest, c);
+      best = detail::hit_bound(rc, hit.t);
+    } else {
+      const BoxTopNode& n = nodes[cur.ref];
+      if constexpr (kCount) ++c->box_node_visits;
+      V enter = simd::splat<4>(-inf), exit = simd::splat<4>(inf);
+      const float* box = &n.lo[0][0];
+      for (int k = 0; k < 3; ++k) {
+        const V e = (simd::load<4>(box + near_off[k]) - rc.o[k]) * rc.inv[k];
+        const V x = (simd::load<4>(box + far_off[k]) - rc.o[k]) * rc.inv[k];
+        enter = e > enter ? e : enter;  // NaN crossings do not clip
+        exit = x < exit ? x : exit;
+      }
+      const float hi = cur.tmax < best ? cur.tmax : best;
+      enter = detail::widen_dn(enter);
+      exit = detail::widen_up(exit);
+      enter = enter > cur.tmin ? enter : simd::splat<4>(cur.tmin);
+      exit = exit < hi ? exit : simd::splat<4>(hi);
+      const auto live = (enter <= exit) &
+                        (simd::load_int<4>(reinterpret_cast<const std::int32_t*>(n.child)) != -1);
+      unsigned bits = simd::movemask<4>(live);
+      if (bits != 0) {
+        alignas(16) float lo[4], up[4];
+        simd::store<4>(lo, enter);
+        simd::store<4>(up, exit);
+        const int i0 = std::countr_zero(bits);
+        bits &= bits - 1;
+        Entry a{n.child[i0], lo[i0], up[i0]};
+        if (bits == 0) {  // one box: the common case, no ordering
+          cur = a;
+          continue;
+        }
+        const int i1 = std::countr_zero(bits);
+        bits &= bits - 1;
+        Entry b{n.child[i1], lo[i1], up[i1]};
+        if (b.tmin < a.tmin) std::swap(a, b);
+        if (bits == 0) {
+          stack[sp++] = b;
+          cur = a;
+          continue;
+        }
+        Entry hits[4] = {a, b};  // three or four boxes: insertion sort, nearest first
+        int count = 2;
+        while (bits != 0) {
+          const int i = std::countr_zero(bits);
+          bits &= bits - 1;
+          const Entry e{n.child[i], lo[i], up[i]};
+          int j = count++;
+          for (; j > 0 && hits[j - 1].tmin > e.tmin; --j) hits[j] = hits[j - 1];
+          hits[j] = e;
+        }
+        for (int j = count - 1; j > 0; --j) stack[sp++] = hits[j];
+        cur = hits[0];
+        continue;
+      }
+    }
+    for (;;) {
+      if (sp == 0) return;
+      cur = stack[--sp];
+      if (!(cur.tmin > best)) break;
+    }
+  }
+}
+
+/// One ray through the box top and the subtrees under it.
+template <bool kCount>
+Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCounters* c) {
+  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const WatertightRay& wr, Hit& hit,
+                                          NearestHit& nearest) {
+    walk_top<kCount>(v, nodes, rc, ray, wr, hit, nearest, c);
+  });
+}
+
+/// Bit of CompactBspSlot::kFirstEmpty; kSecondEmpty is the next one.
+constexpr unsigned kFirstBit = unsigned(std::countr_zero(CompactBspSlot::kFirstEmpty));
+static_assert(CompactBspSlot::kSecondEmpty == CompactBspSlot::kFirstEmpty << 1);
+
+/// a where mask is all ones, b where it is 0, by bits: GCC compiles a float
+/// ?: to a branch.
+inline float select_bits(std::uint32_t mask, float a, float b) {
+  return std::bit_cast<float>((std::bit_cast<std::uint32_t>(a) & mask) | (std::bit_cast<std::uint32_t>(b) & ~mask));
+}
+
+/// One ray's state in the interleaved kernel: traverse_subtree's locals, kept
+/// between steps.
+struct Lane {
+  BspRayConst rc;
+  WatertightRay wr;
+  Hit hit;
+  const Ray* ray;
+  std::size_t index;  ///< slot in hits; kIdle: no ray left for this lane
+  std::uint32_t node;
+  std::uint32_t pop;  ///< 1: the last node entered neither child
+  float tmin, tmax;
+  int sp;
+  StackEntry stack[kBspMaxDepth];
+};
+constexpr std::size_t kIdle = ~std::size_t(0);
+
+/// One step of lane L, traverse_subtree's decisions in its order: an inner
+/// node, choosing the child without a branch (the next step's loads wait on
+/// the choice instead of on a predicted jump, which random rays mispredict);
+/// or a leaf (or a node that entered neither child) and the pops after it.
+/// True when the ray is done.
+inline bool lane_step(const BspView& v, Lane& L) {
+  const CompactBspSlot* n = &v.nodes[L.node];
+  if (!(n->is_leaf() | (L.pop != 0))) {
+    float near_hi, far_lo;
+    const std::uint32_t flip = cut_node<false>(n, L.rc, near_hi, far_lo, nullptr) ? 1u : 0u;
+    const std::uint32_t head = n->head, first = L.node + n->slots(), second = n->second_child();
+    const std::uint32_t near = first ^ ((first ^ second) & (0u - flip)), far = near ^ first ^ second;
+    const std::uint32_t near_full = ~(head >> (kFirstBit + flip)) & 1u;
+    const std::uint32_t far_full = ~(head >> (kFirstBit + 1u - flip)) & 1u;
+    const float tmin = L.tmin, tmax = L.tmax;
+    const std::uint32_t go_near = std::uint32_t(!(near_hi < tmin)) & near_full;  // NaN: both
+    const std::uint32_t go_far = std::uint32_t(!(far_lo > tmax)) & far_full;
+    const float far_min = far_lo > tmin ? far_lo : tmin, near_max = near_hi < tmax ? near_hi : tmax;
+    // The stack has a slot more than the deepest inner node's depth (the
+    // BspTracer constructor checks the depth), so this write stays inside it.
+    L.stack[L.sp] = {far, far_min, tmax};  // kept only when both children are entered
+    L.sp += int(go_near & go_far);
+    const std::uint32_t keep = 0u - go_near;  // all ones: near is next
+    L.node = (near & keep) | (far & ~keep);
+    L.tmin = select_bits(keep, tmin, far_min);
+    L.tmax = select_bits(keep, near_max, tmax);
+    L.pop = (go_near | go_far) ^ 1u;
+    return false;
+  }
+  if (L.pop == 0) {
+    NearestHit unused;  // float leaves only
+    intersect_leaf<false>(v, *n, *L.ray, L.wr, L.hit, unused, nullptr);
+  }
+  const float best = detail::hit_bound(L.rc, L.hit.t);
+  for (;;) {
+    if (L.sp == 0) return true;
+    const StackEntry& e = L.stack[--L.sp];
+    if (e.tmin > best) continue;
+    L.node = e.node;
+    L.tmin = e.tmin;
+    L.tmax = e.tmax < best ? e.tmax : best;
+    L.pop = 0;
+    return false;
+  }
+}
+
+/// Rays in flight in the interleaved kernel (4 and 16 measured no faster).
+constexpr int kLanes = 8;
+
+/// Single rays through the whole tree, kLanes at a time in round robin: while
+/// one ray's step waits on its loads and arithmetic, the others' run. Each
+/// ray makes exactly the steps of trace_single (float leaves, no counters),
+/// so its hit is the same bit for bit.
+void trace_interleaved(const BspView& v, const Ray* rays, std::size_t count, Hit* hits) {
+  Lane lanes[kLanes];
+  std::size_t next = 0;
+  auto start = [&](Lane& L) {  // the lane's next live ray, or kIdle
+    while (next < count) {
+      const std::size_t i = next++;
+      L.rc = detail::bsp_ray_setup(rays[i], v.bounds, v.certified);
+      if (!L.rc.live) {
+        hits[i] = Hit{};
+        continue;
+      }
+      L.wr = watertight_precompute(rays[i]);
+      L.hit = Hit{};
+      L.ray = &rays[i];
+      L.index = i;
+      L.node = 0;
+      L.pop = 0;
+      L.tmin = L.rc.tmin;
+      L.tmax = L.rc.tmax;
+      L.sp = 0;
+      return;
+    }
+    L.index = kIdle;
+  };
+  int active = 0;
+  for (Lane& L : lanes) {
+    start(L);
+    active += L.index != kIdle;
+  }
+  while (active > 0) {
+    for (Lane& L : lanes) {
+      if (L.index == kIdle || !lane_step(v, L)) continue;
+      hits[L.index] = L.hit;
+      start(L);
+      active -= L.index == kIdle;
+    }
+  }
+}
+
+/// Depth of the deepest leaf.
+int tree_depth(const FlatBspTree& tree) { return flat_bsp_stats(tree).max_depth; }
+
+}  // namespace
+
+BspTracer::BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode)
+    : tree_(std::move(tree)), mode_(mode) {
+  try {
+    tree_.validate();
+  } catch (const std::logic_error& e) {
+    throw UsageError(std::string("flat BSP tree is not valid: ") + e.what());
+  }
+  if (tree_.triangle_count != soup.size())
+    throw UsageError("BSP tree built for " + std::to_string(tree_.triangle_count) +
+                     " triangles, scene has " + std::to_string(soup.size()));
+  if (tree_depth(tree_) >= kBspMaxDepth)
+    throw UsageError("BSP tree deeper than " + std::to_string(kBspMaxDepth) + " levels");
+  if (mode_ == BspEpsilon::Zero)
+    for (std::size_t i = 0; i + 1 < tree_.nodes.size(); ++i)
+      if (tree_.nodes[i].is_plane()) tree_.nodes[++i].set_tail_eps(0.0f);
+  compact_ = compact_bsp(tree_);
+  tree_.nodes = {};  // traversal reads compact_; the leaf lists stay in tree_.prims
+  triangles_.resize(tree_.prims.size());
+  for (std::size_t i = 0; i < tree_.prims.size(); ++i) {
+    const auto c = soup.corners(tree_.prims[i]);
+    triangles_[i] = {{c[0], c[1], c[2]}};
+  }
+}
+
+namespace {
+BspView make_view(const FlatBspTree& t, const CompactBspTree& c, const std::vector<BspTriangle>& tris,
+                  BspEpsilon mode, const LeafIntersector* exact_leaf) {
+  return BspView{c.slots.data(), t.prims.data(), tris.data(), t.bounds, mode == BspEpsilon::Certified,
+                 exact_leaf};
+}
+}  // namespace
+
+namespace {
+/// Whether test(i) holds for at least half of up to 16 evenly spaced i in [0, n).
+template <typename Test>
+bool half_of_samples(std::size_t n, Test test) {
+  const std::size_t samples = std::min<std::size_t>(16, n), step = n / samples;
+  std::size_t yes = 0;
+  for (std::size_t p = 0; p < samples; ++p) yes += test(p * step);
+  return 2 * yes >= samples;
+}
+}  // namespace
+
+bool rays_look_coherent(std::span<const Ray> rays) {
+  if (rays.size() < 2) return true;
+  return half_of_samples(rays.size() - 1, [&](std::size_t i) {
+    const Vec3f a = rays[i].dir, b = rays[i + 1].dir;
+    const float ab = dot(a, b);  // cos^2 > 0.98: within about 8 degrees; NaN: not close
+    return ab > 0.0f && ab * ab > 0.98f * dot(a, a) * dot(b, b);
+  });
+}
+
+bool rays_unbounded(std::span<const Ray> rays) {
+  return !rays.empty() && half_of_samples(rays.size(), [&](std::size_t i) {
+    return rays[i].tfar == std::numeric_limits<float>::infinity();
+  });
+}
+
+Hit BspTracer::trace(const Ray& ray, RayCounters* counters) const {
+  const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
+  if (tree_.bounds.empty()) {
+    if (counters) ++counters->rays;
+    return Hit{};
+  }
+  if (has_top_) {
+    if (top_.nodes.empty()) {
+      if (counters) ++counters->rays;
+      return Hit{};
+    }
+    return counters ? trace_top<true>(v, top_.nodes.data(), ray, counters)
+                    : trace_top<false>(v, top_.nodes.data(), ray, nullptr);
+  }
+  return counters ? trace_single<true>(v, ray, counters) : trace_single<false>(v, ray, nullptr);
+}
+
+void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
+                            RayCounters* counters) const {
+  if (hits.size() != rays.size())
+    throw UsageError("trace_batch: " + std::to_string(rays.size()) + " rays but " +
+                     std::to_string(hits.size()) + " hits");
+  const Isa need = isa_for_width(packet_width);  // UsageError for bad widths
+  if (int(detected_isa()) < int(need))
+    throw UsageError("packets of " + std::to_string(packet_width) + " rays need " +
+                     isa_name(need) + ", this CPU has " + isa_name(detected_isa()));
+  const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
+  // Exact leaves and box tops trace single rays.
+  if (need == Isa::Scalar || tree_.bounds.empty() || exact_leaf_ || has_top_) {
+    const bool interleave = !counters && !exact_leaf_ && !has_top_ && !tree_.bounds.empty() &&
+                            (single_rays_ == BspSingleRays::Interleaved ||
+                             (single_rays_ == BspSingleRays::Auto && !rays_look_coherent(rays) &&
+                              rays_unbounded(rays)));
+    if (interleave) {
+      trace_interleaved(v, rays.data(), rays.size(), hits.data());
+      return;
+    }
+    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
+    return;
+  }
+  switch (need) {
+    case Isa::Sse42:
+      detail::bsp_trace_packets_sse42(v, rays.data(), rays.size(), hits.data(), counters);
+      break;
+    case Isa::Avx2:
+      detail::bsp_trace_packets_avx2(v, rays.data(), rays.size(), hits.data(), counters);
+      break;
+    case Isa::Avx512:
+      detail::bsp_trace_packets_avx512(v, rays.data(), rays.size(), hits.data(), counters);
+      break;
+    case Isa::Scalar: break;
+  }
+}
+
+std::vector<BspSubtreeBox> BspTracer::subtree_boxes(std::uint32_t max_slots) const {
+  return bsp_subtree_boxes(compact_, triangles_, tree_.bounds, max_slots);
+}
+
+void BspTracer::set_box_top(BoxTop top) {
+  top_ = std::move(top);
+  has_top_ = true;
+}
+
+std::size_t BspTracer::memory_bytes() const {
+  return top_.nodes.size() * sizeof(BoxTopNode) + compact_.slots.size() * sizeof(CompactBspSlot) +
+         tree_.prims.size() * sizeof(std::uint32_t) + triangles_.size() * sizeof(BspTriangle);
+}
+
+}  // namespace bsprt

@@ -1,0 +1,124 @@
+#pragma once
+/// \file bsp_traverse.h
+/// Ray casting through the flat BSP tree (bsp_node.h): single rays front to back
+/// with a fixed stack and early exit, and SIMD packets of 4/8/16 rays, both
+/// *certified*: a ray whose exact path meets a triangle inside a leaf's cell
+/// before its nearest hit visits that leaf (docs/certified-epsilons.md). BSP
+/// nodes cost two dot products (Ize, Wald, Parker, RT 2008, §5); axis-aligned
+/// splits use the kd formula. The conservative interval logic follows the
+/// spirit of Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013: bound every
+/// rounding and widen, never trust a float comparison near the plane. Leaves
+/// use the watertight test (watertight.h).
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "geometry/core/triangle_soup.h"
+#include "traverse/bsp/bsp_boxtop.h"
+#include "traverse/bsp/bsp_compact.h"
+#include "traverse/bsp/bsp_node.h"
+#include "traverse/leaf_intersector.h"
+#include "traverse/accelerator.h"
+
+namespace bsprt {
+
+/// Which slab bounds traversal uses (STYLE.md 8: robustness explicit in types).
+enum class BspEpsilon {
+  /// The certified bounds: per-node eps from the exact cell plus the per-ray
+  /// rounding bound of the plane evaluation. No lost hit (docs).
+  Certified,
+  /// All slab bounds zero (the crossing t is still widened by a few ulps): the
+  /// naive float traversal, kept to measure what certification costs. May
+  /// lose hits near planes.
+  Zero,
+};
+
+/// How BspTracer::trace_batch runs single rays. Every choice makes each ray's
+/// steps of trace() in the same order, so hits are the same bit for bit; only
+/// speed differs.
+enum class BspSingleRays {
+  /// Interleaved when the batch looks incoherent (not rays_look_coherent) and
+  /// its rays are unbounded (rays_unbounded); else sequential. Shadow rays
+  /// (short segments to a light) were slower interleaved
+  /// (docs/certified-epsilons.md §11).
+  Auto,
+  /// One ray after the other, the branchy loop of trace(): fastest on
+  /// coherent rays, whose branches the CPU predicts.
+  Sequential,
+  /// Eight rays in flight, each inner step choosing its child without a
+  /// branch: fastest on long incoherent rays (random, vertex- and
+  /// edge-aimed).
+  Interleaved,
+};
+
+/// Whether a batch looks coherent, like camera rays in tiles: at least half of
+/// up to 16 evenly spaced pairs of neighbouring rays have directions within
+/// about 8 degrees of each other. Picks the single-ray kernel only.
+bool rays_look_coherent(std::span<const Ray> rays);
+
+/// Whether at least half of up to 16 evenly spaced rays of a batch have
+/// tfar = +inf (an empty batch: false). Picks the single-ray kernel only.
+bool rays_unbounded(std::span<const Ray> rays);
+
+/// The flat BSP tree behind the Accelerator interface. Copies the triangle corners
+/// it needs, so the soup need not outlive it.
+class BspTracer final : public Accelerator {
+ public:
+  /// Takes ownership of `tree`, built for `soup`. Throws UsageError when the
+  /// tree fails FlatBspTree::validate(), is deeper than kBspMaxDepth (128), or
+  /// was built for a scene with another triangle count.
+  BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode = BspEpsilon::Certified);
+
+  /// bsp, bsp-certified, bsp-zero-eps; with a box top bsp-top, bsp-top-certified, bsp-top-zero-eps.
+  std::string name() const override {
+    const std::string base = exact_leaf_ ? "bsp-certified" : (mode_ == BspEpsilon::Zero ? "bsp-zero-eps" : "bsp");
+    return has_top_ ? "bsp-top" + base.substr(3) : base;
+  }
+  /// Tests leaves with `exact` (exact decisions, robust/certified_intersector.h)
+  /// instead of the float watertight test; it must outlive the tracer. With
+  /// certified epsilons this makes every decision exact: the nearest hit equals
+  /// the exact reference's. Packets then run as single rays.
+  void set_exact_leaf(const LeafIntersector* exact) { exact_leaf_ = exact; }
+  /// Single ray, front to back; counts bsp_node_visits, kd_node_visits,
+  /// leaf_visits, triangle_tests and rays when `counters` is non-null.
+  Hit trace(const Ray& ray, RayCounters* counters = nullptr) const override;
+  /// packet_width 1 = single rays (run as set_single_rays says); 4, 8, 16 =
+  /// SSE4.2, AVX2, AVX-512 packets (UsageError when the CPU lacks the ISA).
+  /// Each lane runs exactly the single-ray steps (lanes that disagree on a
+  /// node's near child wait on the stack), so hits and counters equal single
+  /// rays bit for bit. With exact leaves or a box top packets run as single
+  /// rays; with counters, exact leaves or a box top single rays run
+  /// sequentially.
+  void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width = 1,
+                   RayCounters* counters = nullptr) const override;
+  /// The tree cut into subtrees of at most `max_slots` slots, with their
+  /// certified boxes (bsp_boxtop.h), to build a box top from.
+  std::vector<BspSubtreeBox> subtree_boxes(std::uint32_t max_slots) const;
+  /// Traces single rays through `top` (built from subtree_boxes()) before the
+  /// BSP subtrees; packets then run as single rays.
+  void set_box_top(BoxTop top);
+  bool has_box_top() const { return has_top_; }
+  /// How trace_batch runs single rays (default Auto); not while tracing.
+  void set_single_rays(BspSingleRays how) { single_rays_ = how; }
+  BspSingleRays single_rays() const { return single_rays_; }
+  const BoxTop& box_top() const { return top_; }
+  /// Nodes, leaf lists, the copied triangles and the box top.
+  std::size_t memory_bytes() const override;
+
+  BspEpsilon mode() const { return mode_; }
+  /// The traversal layout made from the tree (bsp_compact.h).
+  const CompactBspTree& compact() const { return compact_; }
+
+ private:
+  FlatBspTree tree_;  ///< bounds, leaf lists; nodes dropped after compacting
+  CompactBspTree compact_;
+  BspEpsilon mode_;
+  const LeafIntersector* exact_leaf_ = nullptr;
+  std::vector<BspTriangle> triangles_;  ///< triangles_[i] = corners of tree_.prims[i]
+  BoxTop top_;
+  bool has_top_ = false;
+  BspSingleRays single_rays_ = BspSingleRays::Auto;
+};
+
+}  // namespace bsprt
