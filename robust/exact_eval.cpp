@@ -11,6 +11,7 @@
 
 #include "geometry/core/check.h"
 #include "robust/exact_side.h"
+#include "robust/plane_formula.h"
 
 namespace bsprt {
 
@@ -34,24 +35,9 @@ struct ExactPlane {
 };
 
 ExactPlane exact_plane(const TriangleSoup& soup, PlaneDef p) {
-  ExactPlane e{{NT(0.0), NT(0.0), NT(0.0)}, NT(-double(p.coord()))};
-  if (p.is_kd()) {
-    e.n[p.axis()] = NT(1.0);
-    return e;
-  }
-  const std::uint32_t t = p.tri();
-  const V3 p0 = to_v3(soup.corner(t, 0)), p1 = to_v3(soup.corner(t, 1)), p2 = to_v3(soup.corner(t, 2));
-  V3 n = cross3(sub(p1, p0), sub(p2, p0));
-  V3 r = p0;
-  if (p.kind == PlaneKind::Edge) {
-    const int k = p.edge_index();
-    const V3 a0 = to_v3(soup.corner(t, k)), a1 = to_v3(soup.corner(t, (k + 1) % 3));
-    n = cross3(n, sub(a1, a0));
-    r = a0;
-  }
-  e.d = -dot3(n, r);
-  e.n = n;
-  return e;
+  const PlaneFormula<NT> f = plane_formula<NT>(soup, p);
+  const V3 n = {f.n.x, f.n.y, f.n.z};
+  return {n, p.is_kd() ? NT(-double(p.coord())) : -dot3(n, to_v3(f.through))};
 }
 
 /// Homogeneous intersection (N, D) of three planes: the point is N / D.

@@ -8,6 +8,7 @@
 
 #include "geometry/core/check.h"
 #include "robust/exact_side.h"
+#include "robust/plane_formula.h"
 
 namespace bsprt {
 
@@ -16,33 +17,16 @@ namespace {
 using IA = CGAL::Interval_nt<false>;
 using IV = std::array<IA, 3>;
 
-IV iv(const Vec3f& p) { return {IA(double(p.x)), IA(double(p.y)), IA(double(p.z))}; }
-IV isub(const IV& a, const IV& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 IV icross(const IV& a, const IV& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 IA idot(const IV& a, const IV& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/// Interval normal and exact reference point of a stored plane.
+/// Interval normal and exact reference point of a stored plane (plane_formula.h).
 void plane_normal(const TriangleSoup& soup, PlaneDef p, IV& n, std::array<double, 3>& ref) {
-  if (p.is_kd()) {
-    n = {IA(0.0), IA(0.0), IA(0.0)};
-    n[p.axis()] = IA(1.0);
-    ref = {0.0, 0.0, 0.0};
-    ref[p.axis()] = double(p.coord());
-    return;
-  }
-  const std::uint32_t t = p.tri();
-  const Vec3f& c0 = soup.corner(t, 0);
-  const IV p0 = iv(c0), p1 = iv(soup.corner(t, 1)), p2 = iv(soup.corner(t, 2));
-  n = icross(isub(p1, p0), isub(p2, p0));
-  ref = {double(c0.x), double(c0.y), double(c0.z)};
-  if (p.kind == PlaneKind::Edge) {
-    const int k = p.edge_index();
-    const Vec3f& a0 = soup.corner(t, k);
-    n = icross(n, isub(iv(soup.corner(t, (k + 1) % 3)), iv(a0)));
-    ref = {double(a0.x), double(a0.y), double(a0.z)};
-  }
+  const PlaneFormula<IA> f = plane_formula<IA>(soup, p);
+  n = {f.n.x, f.n.y, f.n.z};
+  ref = {double(f.through.x), double(f.through.y), double(f.through.z)};
 }
 
 int certain_sign(const IA& v) {

@@ -4,33 +4,21 @@
 
 #include <cmath>
 
-namespace bsprt {
+#include "robust/plane_formula.h"
 
-namespace {
-Vec3d corner_d(const TriangleSoup& soup, std::uint32_t t, int k) { return Vec3d(soup.corner(t, k)); }
-}  // namespace
+namespace bsprt {
 
 ApproxPlane approx_plane(const TriangleSoup& soup, PlaneDef p) {
   ApproxPlane a;
+  const PlaneFormula<double> f = plane_formula<double>(soup, p);
   if (p.is_kd()) {
-    a.n = Vec3d(0, 0, 0);
-    a.n[p.axis()] = 1.0;
+    a.n = f.n;
     a.d = -double(p.coord());
     return a;
   }
-  const std::uint32_t t = p.tri();
-  const Vec3d p0 = corner_d(soup, t, 0), p1 = corner_d(soup, t, 1), p2 = corner_d(soup, t, 2);
-  Vec3d n = cross(p1 - p0, p2 - p0);
-  Vec3d r = p0;
-  if (p.kind == PlaneKind::Edge) {
-    const int k = p.edge_index();
-    const Vec3d a0 = corner_d(soup, t, k), a1 = corner_d(soup, t, (k + 1) % 3);
-    n = cross(n, a1 - a0);
-    r = a0;
-  }
-  const double len = length(n);
-  a.n = len > 0 ? n / len : Vec3d(0, 0, 0);
-  a.d = -dot(a.n, r);
+  const double len = length(f.n);
+  a.n = len > 0 ? f.n / len : Vec3d(0, 0, 0);
+  a.d = -dot(a.n, Vec3d(f.through));
   return a;
 }
 

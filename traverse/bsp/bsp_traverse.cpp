@@ -15,6 +15,7 @@
 #include "traverse/bsp/bsp_kernel.h"
 #include "traverse/simd/cpu_features.h"
 #include "traverse/simd/simd.h"
+#include "traverse/stack_step.h"
 #include "traverse/watertight.h"
 
 namespace bsprt {
@@ -27,10 +28,7 @@ using detail::BspView;
 constexpr int kTopStackSize = 3 * 64 + 4;
 
 /// A far child waiting on the stack with the ray's (conservative) interval.
-struct StackEntry {
-  std::uint32_t node;
-  float tmin, tmax;
-};
+using detail::StackEntry;
 
 /// Tests the triangles of a leaf (ties keep the earlier triangle). With an
 /// exact leaf test, `nearest` keeps the exact order and hit mirrors it.
@@ -95,20 +93,7 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       const bool near_empty = flip ? n->second_empty() : n->first_empty();
       const bool far_empty = flip ? n->first_empty() : n->second_empty();
       const bool go_near = !(near_hi < tmin) && !near_empty, go_far = !(far_lo > tmax) && !far_empty;  // NaN: both
-      if (go_far) {
-        const float far_min = far_lo > tmin ? far_lo : tmin;
-        if (go_near) {
-          stack[sp++] = {far, far_min, tmax};
-          node = near;
-          tmax = near_hi < tmax ? near_hi : tmax;
-        } else {
-          node = far;
-          tmin = far_min;
-        }
-      } else if (go_near) {
-        node = near;
-        tmax = near_hi < tmax ? near_hi : tmax;
-      } else {
+      if (!detail::step_near_far(near, far, go_near, go_far, near_hi, far_lo, node, tmin, tmax, stack, sp)) {
         leaf = false;
         break;
       }
@@ -118,15 +103,7 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
       best = detail::hit_bound(rc, hit.t);
     }
-    for (;;) {
-      if (sp == 0) return;
-      const StackEntry& e = stack[--sp];
-      if (e.tmin > best) continue;
-      node = e.node;
-      tmin = e.tmin;
-      tmax = e.tmax < best ? e.tmax : best;
-      break;
-    }
+    if (!detail::pop_before(stack, sp, best, node, tmin, tmax)) return;
   }
 }
 

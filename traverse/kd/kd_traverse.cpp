@@ -9,6 +9,7 @@
 #include "bsprt/error.h"
 #include "traverse/simd/cpu_features.h"
 #include "traverse/kd/kd_kernel.h"
+#include "traverse/stack_step.h"
 #include "traverse/watertight.h"
 
 namespace bsprt {
@@ -19,10 +20,7 @@ using detail::kKdTHi;
 using detail::kKdTLo;
 
 /// A far child waiting on the stack with the ray's (widened) interval in it.
-struct StackEntry {
-  std::uint32_t node;
-  float tmin, tmax;
-};
+using detail::StackEntry;
 
 /// Clips [tmin, tmax] to the root cell, with the same widening as the nodes.
 /// A zero direction component gives inv = +-inf: outside the slab both t are
@@ -89,34 +87,12 @@ Hit trace_from(const KdView& v, const WatertightRay& wr, const float o[3],
       const std::uint32_t lower = node + 1, upper = n->upper_child();
       const std::uint32_t near = neg[k] ? upper : lower, far = neg[k] ? lower : upper;
       const bool go_near = !(th < tmin), go_far = !(tl > tmax);  // NaN: both
-      if (go_far) {
-        const float far_min = tl > tmin ? tl : tmin;
-        if (go_near) {
-          stack[sp++] = {far, far_min, tmax};
-          node = near;
-          tmax = th < tmax ? th : tmax;
-        } else {
-          node = far;
-          tmin = far_min;
-        }
-      } else if (go_near) {
-        node = near;
-        tmax = th < tmax ? th : tmax;
-      } else {
-        break;  // cannot happen (th >= tl, NaN visits both), kept for safety
-      }
+      // Neither: cannot happen (th >= tl, NaN visits both), kept for safety.
+      if (!detail::step_near_far(near, far, go_near, go_far, th, tl, node, tmin, tmax, stack, sp)) break;
       n = &v.nodes[node];
     }
     if (n->is_leaf()) intersect_leaf<kCount>(v, *n, wr, hit, c);
-    for (;;) {
-      if (sp == 0) return hit;
-      const StackEntry& e = stack[--sp];
-      if (e.tmin > hit.t) continue;
-      node = e.node;
-      tmin = e.tmin;
-      tmax = e.tmax < hit.t ? e.tmax : hit.t;
-      break;
-    }
+    if (!detail::pop_before(stack, sp, hit.t, node, tmin, tmax)) return hit;
   }
 }
 
