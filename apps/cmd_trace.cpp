@@ -94,7 +94,7 @@ void run(const TraceArgs& a) {
   if (a.json) {
     fmt::print("{{\"accel\": \"{}\", \"rays\": {}, \"hits\": {}, \"build_seconds\": {:.6f}, "
                "\"trace_seconds\": {:.6f}, \"mrays_per_second\": {:.4f}, \"packets\": {}",
-               tracer->name(), rays.size(), nhit, build_s, trace_s, mrays, a.trace.packets);
+               a.trace.accel, rays.size(), nhit, build_s, trace_s, mrays, a.trace.packets);
     if (a.stats)
       fmt::print(", \"per_ray\": {{\"kd_node_visits\": {:.4f}, \"bsp_node_visits\": {:.4f}, "
                  "\"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}, \"box_node_visits\": {:.4f}}}",
@@ -108,7 +108,7 @@ void run(const TraceArgs& a) {
     fmt::print("}}\n");
     return;
   }
-  fmt::print("accel {}: {} rays, {} hits, build {:.3f} s, trace {:.3f} s, {:.2f} Mrays/s\n", tracer->name(),
+  fmt::print("accel {}: {} rays, {} hits, build {:.3f} s, trace {:.3f} s, {:.2f} Mrays/s\n", a.trace.accel,
              rays.size(), nhit, build_s, trace_s, mrays);
   if (a.stats)
     fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests{}\n",
