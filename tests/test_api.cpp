@@ -59,6 +59,10 @@ TEST_CASE("api: Scene::load counts what the CLI counts", "[api]") {
   CHECK(s.triangle_count() == 968);
   CHECK(s.vertex_count() == 507);
   CHECK(s.summary().degenerate == 0);
+  CHECK(s.summary().source == test::scene_path("suzanne.obj"));
+  const Box3f b = s.bounds();  // `bsprt info`: [-3.86125, 0.267311, 3.25233] .. [-1.126875, 2.236061, 4.955455]
+  CHECK(b.lo.x == Approx(-3.86125));
+  CHECK(b.hi.z == Approx(4.955455));
   const test::CliRun info = test::bsprt_cli("info " + test::scene_path("suzanne.obj"));
   REQUIRE(info.status == 0);
   CHECK(info.output.find("triangles   968") != std::string::npos);
@@ -226,6 +230,8 @@ TEST_CASE("api: every mode at every packet width and thread count gives the CLI'
     const std::vector<Hit> expected = read_hits(out);
     const Tracer t(scene, bsp, mode);
     CHECK(t.name() == accel);
+    CHECK(t.memory_bytes() > 0);
+    CHECK(bsp.scene().fingerprint() == scene.fingerprint());
     for (int threads : {1, 2, 0})
       for (int packets : {1, 8}) {
         std::vector<Hit> hits(rays.size());

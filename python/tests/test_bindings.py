@@ -110,6 +110,10 @@ def test_trace_equals_cli(tmp_path, suzanne, accel, mode, cli_mode):
     out = tmp_path / "api.hits"
     bsprt.write_hits(str(out), h.records)
     assert out.read_bytes() == hits_path.read_bytes()
+    rays_out = tmp_path / "api.rays"
+    bsprt.write_rays(str(rays_out), bsprt.make_rays(rays[:, 0:3], rays[:, 4:7], rays[:, 3], rays[:, 7]))
+    assert rays_out.read_bytes() == rays_path.read_bytes()
+    assert t.memory_bytes > 0 and bsprt.Tracer(scene, accel="brute").memory_bytes == 0
 
 
 def test_certified_equals_exact_and_compare(tmp_path, suzanne):
