@@ -1,5 +1,5 @@
 // bench_micro: Google Benchmark micro-benchmarks of the per-ray building
-// blocks, to turn per-ray counters into time (docs/certified-epsilons.md §8):
+// blocks, to turn per-ray counters into time (docs/notes/2026-11-22-face-hits.md):
 //
 //   BM_WatertightHit    the watertight test of a primary ray against the
 //                       triangle it hits (a leaf test that finds the hit)

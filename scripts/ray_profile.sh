@@ -4,7 +4,7 @@
 # timings on a shared VM). Each mode traces N rays and then a single ray with
 # the same load and build; the difference divided by N-1 is the per-ray cost,
 # so mesh loading, tree reading and Embree's build drop out.
-# docs/certified-epsilons.md §13 quotes this table.
+# docs/notes/2026-12-01-speed-targets.md quotes this table.
 #   scripts/ray_profile.sh                           # bunny, 100000 rays per set
 #   scripts/ray_profile.sh path/to/mesh.ply 50000    # another mesh, fewer rays
 #   MODES="kd bsp:interleaved" RAYSETS=random BSPRT_BUILD_DIR=dir BSPRT_SKIP_DEPS=1 scripts/ray_profile.sh

@@ -531,7 +531,7 @@ TEST_CASE("BSP special rays equal brute force", "[bsp]") {
   }
 }
 
-// Found measuring the huge-ray fallback (docs/certified-epsilons.md §4,
+// Found measuring the huge-ray fallback (docs/notes/2026-12-01-direction-scaling.md,
 // 2026-12-01): a ray whose direction was multiplied by 2^70 or 2^-70, the same
 // geometric ray, visited every node and leaf of the tree: 12 ms a ray on the
 // bunny, 7x brute force. The traversal now follows the direction scaled back

@@ -41,7 +41,7 @@ enum class BspSingleRays {
   /// Interleaved when the batch looks incoherent (not rays_look_coherent) and
   /// its rays are unbounded (rays_unbounded); else sequential. Shadow rays
   /// (short segments to a light) were slower interleaved
-  /// (docs/certified-epsilons.md §11).
+  /// (docs/certified-epsilons.md §11, docs/notes/2026-11-22-interleaved-single-rays.md).
   Auto,
   /// One ray after the other, the branchy loop of trace(): fastest on
   /// coherent rays, whose branches the CPU predicts.
