@@ -19,20 +19,22 @@ std::string ratio_cell(double x) { return x > 0 ? fmt::format("{:.2f}", x) : std
 
 std::string md_table_header() {
   return "| mode | build s | Mrays/s single | Mrays/s packet | vs kd | vs embree | kd+bsp nodes/ray | tri tests/ray "
-         "| MB | error rays | lost | extra | farther (leaks) | nearer | max t ulps | median t ulps |\n"
-         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+         "| MB | bytes/tri | error rays | lost | extra | farther (leaks) | nearer | max t ulps | median t ulps |\n"
+         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
 }
 
 std::string md_row(const BenchResult& res, const BenchRow& r) {
   const bool err = r.error_rays > 0;
   const auto cnt = [&](std::uint64_t v) { return err ? fmt::format("{}", v) : std::string("–"); };
   const bool counted = r.kd_visits + r.bsp_visits + r.triangle_tests > 0;  // Embree has no counters
-  return fmt::format("| {} | {:.3f} | {:.2f} | {} | {} | {} | {} | {} | {:.1f} | {} | {} | {} | {} | {} | {} | {} |\n",
+  return fmt::format("| {} | {:.3f} | {:.2f} | {} | {} | {} | {} | {} | {:.1f} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
                      r.mode, r.build_seconds, r.mrays_single,
                      r.packet_width > 1 ? fmt::format("{:.2f} ({})", r.mrays_packet, r.packet_width) : "single only",
                      ratio_cell(bench_speed_ratio(res, r, "kd")), ratio_cell(bench_speed_ratio(res, r, "embree")),
                      counted ? fmt::format("{:.1f}", r.kd_visits + r.bsp_visits) : "–",
                      counted ? fmt::format("{:.2f}", r.triangle_tests) : "–", double(r.memory_bytes) / 1e6,
+                     r.triangles && r.memory_bytes ? fmt::format("{:.0f}", double(r.memory_bytes) / double(r.triangles))
+                                                   : std::string("–"),
                      err ? fmt::format("{}", r.error_rays) : "–", cnt(r.error.lost), cnt(r.error.extra),
                      cnt(r.error.farther), cnt(r.error.nearer), err ? fmt::format("{:.0f}", r.error.max_t_ulps) : "–",
                      err ? fmt::format("{:.1f}", r.median_t_ulps) : "–");
