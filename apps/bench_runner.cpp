@@ -42,11 +42,18 @@ bool is_slow_mode(const std::string& mode) { return accel_info(mode).slow; }
 
 bool is_bsp_mode(const std::string& mode) { return accel_info(mode).tree == AccelTree::Bsp; }
 
-/// About n primary rays framing the scene, 4:3, in 8x8 tiles (ray_gen.h).
-std::vector<Ray> tiled_primary_rays(const TriangleSoup& soup, std::size_t n) {
+/// About n primary rays from `cam`, 4:3, in 8x8 tiles (ray_gen.h).
+std::vector<Ray> tiled_primary_rays(const Camera& cam, std::size_t n) {
   const int width = std::max(8, int(std::lround(std::sqrt(double(n) * 4.0 / 3.0))));
   const int height = std::max(8, int(std::lround(double(n) / width)));
-  return bsprt::tiled_primary_rays(frame_bounds(soup.bounds()), width, height);
+  return bsprt::tiled_primary_rays(cam, width, height);
+}
+
+/// The scene's camera from BenchOptions::cameras (matched by file stem), or one framing it.
+Camera bench_camera(const BenchScene& scene, const std::vector<NamedCamera>& cameras) {
+  for (const NamedCamera& c : cameras)
+    if (!c.scene.empty() && std::filesystem::path(c.scene).stem().string() == scene.name) return c.camera;
+  return frame_bounds(scene.soup.bounds());
 }
 
 /// Rays from origins uniform in `ball` shrunk to half its radius, directions
@@ -69,8 +76,8 @@ std::vector<Ray> inside_rays(Vec3f center, float radius, std::size_t n, std::uin
 
 /// The ray set named `name` for `scene`, or nothing when it does not apply.
 std::optional<std::vector<Ray>> make_ray_set(const std::string& name, const BenchScene& scene, std::size_t n,
-                                             std::uint64_t seed) {
-  if (name == "primary") return tiled_primary_rays(scene.soup, n);
+                                             std::uint64_t seed, const std::vector<NamedCamera>& cameras) {
+  if (name == "primary") return tiled_primary_rays(bench_camera(scene, cameras), n);
   if (name == "inside") {
     if (!scene.inside_ball) return std::nullopt;
     return inside_rays(scene.inside_ball->first, scene.inside_ball->second, n, seed);
@@ -181,7 +188,7 @@ void bench_scene(const BenchScene& scene, const BenchOptions& o, int threads, in
                  const std::function<void(const std::string&)>& step) {
   const std::vector<BuiltMode> built = build_modes(scene, o, threads, step);
   for (const std::string& set : o.ray_sets) {
-    const auto rays = make_ray_set(set, scene, o.count, o.seed);
+    const auto rays = make_ray_set(set, scene, o.count, o.seed, o.cameras);
     if (!rays) {
       result.notes.push_back(fmt::format("{}: ray set '{}' skipped (no known inside region)", scene.name, set));
       for (std::size_t i = 0; i < built.size() + 1; ++i) step(fmt::format("{}: {} skipped", scene.name, set));

@@ -20,6 +20,7 @@
 #include "traverse/counters.h"
 #include "traverse/accelerator.h"
 #include "geometry/core/triangle_soup.h"
+#include "geometry/io/camera_file.h"
 #include "bsprt/vec3.h"
 
 namespace bsprt {
@@ -52,6 +53,10 @@ struct BenchOptions {
   int threads = 0;                  ///< worker threads for every mode (0 = all cores)
   int runs = 2;                     ///< timing passes per measurement; the fastest counts
   std::uint64_t seed = 1;           ///< ray-set seed
+  /// Cameras by scene (bench --cameras FILE, geometry/io/camera_file.h): a
+  /// scene with one traces its primary rays from it (e.g. sponza's atrium),
+  /// the others from a camera framing the scene.
+  std::vector<NamedCamera> cameras;
   /// Called as work advances: (what is being done, steps done, steps total).
   std::function<void(const std::string&, std::size_t, std::size_t)> progress;
 };

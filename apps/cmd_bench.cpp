@@ -29,6 +29,7 @@ struct BenchArgs {
   std::uint64_t seed = 1;
   std::string output = "bench-out";
   std::string prefix = "bench";
+  std::string cameras;  ///< camera file: primary rays of the scenes it names
 };
 
 void write_file(const std::filesystem::path& path, const std::string& text) {
@@ -65,6 +66,7 @@ void run(const BenchArgs& a) {
   BenchOptions o;
   o.ray_sets = a.rays, o.modes = a.modes, o.count = a.count, o.error_count = a.error_count;
   o.threads = a.threads, o.runs = a.runs, o.seed = a.seed;
+  if (!a.cameras.empty()) o.cameras = read_camera_file(a.cameras);
   std::unique_ptr<ProgressBar> bar;
   o.progress = [&](const std::string&, std::size_t done, std::size_t total) {
     if (!bar) bar = std::make_unique<ProgressBar>("bench", total, "steps", ProgressBar::stderr_is_terminal());
@@ -99,6 +101,8 @@ void register_bench(CLI::App& app) {
   cmd->add_option("--threads", args->threads, "worker threads for every mode (0 = all cores)")->capture_default_str();
   cmd->add_option("--runs", args->runs, "timing passes; the fastest counts")->capture_default_str();
   cmd->add_option("--seed", args->seed, "ray-set seed")->capture_default_str();
+  cmd->add_option("--cameras", args->cameras,
+                  "camera file (e.g. bench/cameras.json): a scene it names traces its primary rays from that camera");
   cmd->add_option("-o,--output", args->output, "directory for PREFIX.md, .csv, .json")->capture_default_str();
   cmd->add_option("--prefix", args->prefix, "base name of the output files")->capture_default_str();
   cmd->callback([args] { run(*args); });

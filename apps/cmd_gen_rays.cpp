@@ -2,9 +2,12 @@
 // edge-aimed) so every tool, Embree included, traces the same rays.
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "apps/cli_common.h"
+#include "geometry/io/camera_file.h"
 #include "geometry/scenes/default_scene.h"
 #include "geometry/scenes/ray_gen.h"
 #include "bsprt/io.h"
@@ -17,6 +20,7 @@ struct GenRaysArgs {
   std::size_t count = 1'000'000;
   std::uint64_t seed = 1;
   std::vector<int> size;
+  std::string camera;  ///< primary rays: --camera FILE[:NAME] instead of framing the scene
   bool allow_nonfinite = false;
 };
 
@@ -24,9 +28,15 @@ void run(const GenRaysArgs& a) {
   const TriangleSoup soup = load_scene(a.scene, a.allow_nonfinite, true);
   const RaySetKind kind = parse_ray_set(a.kind);
   std::vector<Ray> rays;
-  if (kind == RaySetKind::Primary && !a.size.empty()) {
+  if (!a.camera.empty() && kind != RaySetKind::Primary)
+    throw UsageError("--camera is for --kind primary, not " + a.kind);
+  if (kind == RaySetKind::Primary && (!a.size.empty() || !a.camera.empty())) {
     const bool is_default = a.scene.empty() || a.scene == "default";
-    rays = primary_rays(is_default ? default_scene_camera() : frame_bounds(soup.bounds()), a.size[0], a.size[1]);
+    const Camera cam = !a.camera.empty() ? camera_from_spec(a.camera).camera
+                       : is_default      ? default_scene_camera()
+                                         : frame_bounds(soup.bounds());
+    const int side = std::max(1, int(std::lround(std::sqrt(double(a.count)))));
+    rays = primary_rays(cam, a.size.empty() ? side : a.size[0], a.size.empty() ? side : a.size[1]);
   } else {
     rays = make_rays(kind, soup, a.count, a.seed);
   }
@@ -43,6 +53,7 @@ void register_gen_rays(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, ".rays file to write")->required();
   cmd->add_option("--kind", args->kind, "primary | random | vertex | edge")->capture_default_str();
   cmd->add_option("-n,--count", args->count, "number of rays (primary: about n pixels, square)")->capture_default_str();
+  cmd->add_option("--camera", args->camera, "primary rays: camera file FILE or FILE:NAME (docs/rendering.md)");
   cmd->add_option("--size", args->size, "primary rays: image width and height (camera frames the scene)")->expected(2);
   cmd->add_option("--seed", args->seed, "random seed")->capture_default_str();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");

@@ -11,6 +11,7 @@
 #include "apps/path_tracer.h"
 #include "apps/progress.h"
 #include "apps/render.h"
+#include "geometry/io/camera_file.h"
 #include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
 
@@ -23,6 +24,7 @@ struct RenderArgs {
   std::vector<int> size{800, 600};
   std::vector<float> vp, vi, vu;
   float fov = 0.0f;
+  std::string camera;  ///< --camera FILE[:NAME]; --vp/--vi/--vu/--fov override its fields
   bool stats = false;
   int spp = 16, bounces = 3;
   std::uint64_t seed = 1;
@@ -34,7 +36,9 @@ Vec3f to_vec(const std::vector<float>& v) { return {v[0], v[1], v[2]}; }
 
 Camera pick_camera(const RenderArgs& a, const TriangleSoup& soup) {
   const bool is_default = a.scene.empty() || a.scene == "default";
-  Camera cam = is_default ? default_scene_camera() : frame_bounds(soup.bounds());
+  Camera cam = !a.camera.empty() ? camera_from_spec(a.camera).camera
+               : is_default       ? default_scene_camera()
+                                  : frame_bounds(soup.bounds());
   if (!a.vp.empty()) cam.vp = to_vec(a.vp);
   if (!a.vi.empty()) cam.vi = to_vec(a.vi);
   if (!a.vu.empty()) cam.vu = to_vec(a.vu);
@@ -151,6 +155,9 @@ void register_render(CLI::App& app) {
   cmd->add_option("--vi", args->vi, "camera look-at point X Y Z")->expected(3);
   cmd->add_option("--vu", args->vu, "camera up vector X Y Z")->expected(3);
   cmd->add_option("--fov", args->fov, "vertical field of view in degrees");
+  cmd->add_option("--camera", args->camera,
+                  "camera file (docs/rendering.md), FILE or FILE:NAME, e.g. bench/cameras.json:sponza-atrium; "
+                  "--vp/--vi/--vu/--fov override its fields");
   cmd->add_flag("--stats", args->stats, "cast: count and print node visits and triangle tests per ray");
   cmd->add_option("--spp", args->spp, "path: samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--bounces", args->bounces, "path: indirect bounces (0 = direct light)")->capture_default_str()

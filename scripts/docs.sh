@@ -63,30 +63,40 @@ SCALING_CMD=(bench "${scaling_scenes[@]}" --rays random --modes kd,bsp,embree --
 "$BSPRT" "${SCALING_CMD[@]}" | tee "$PERF/scaling.txt"
 
 # 5. Plots.
+# The paper's regime: architectural scenes seen from inside (bench/cameras.json).
+INTERIOR_CMD=(bench "$SCENES/sponza.obj" "$SCENES/conference-331k.obj" --cameras bench/cameras.json
+              --rays primary,random,vertex,edge --modes "$MODES" --count "$COUNT" --error-count "$ERROR_COUNT"
+              -o "$PERF" --prefix interior)
+"$BSPRT" "${INTERIOR_CMD[@]}" | tee "$PERF/interior.txt"
+
 gnuplot -e "dir='$PERF'; rays='vertex'" scripts/plot_error.gp
 gnuplot -e "dir='$PERF'; rays='edge'" scripts/plot_error.gp
 gnuplot -e "dir='$PERF'" scripts/plot_scaling.gp
 
 # 6. Gallery and path-tracing speed per bounce: kd vs bsp (vs embree), trees built once.
-GALLERY=(stanford-bunny.obj stanford-dragon-100k.ply armadillo-86k.obj happy-buddha-res4.ply)
+GALLERY=(stanford-bunny.obj stanford-dragon-100k.ply armadillo-86k.obj happy-buddha-res4.ply sponza.obj conference-331k.obj)
+# Scenes seen from inside get their camera from bench/cameras.json; the scans are framed.
+declare -A CAMERA_OF=([sponza.obj]=sponza-atrium [conference-331k.obj]=conference-room)
 read -r GW GH <<<"$GALLERY_SIZE"
 for m in "${GALLERY[@]}"; do
   s="${m%.*}"
+  cam=()
+  [ -n "${CAMERA_OF[$m]:-}" ] && cam=(--camera "bench/cameras.json:${CAMERA_OF[$m]}")
   for a in kd bsp; do
     "$BSPRT" build "$SCENES/$m" --accel "$a" -o "$PERF/$s.$a.tree" >/dev/null
-    "$BSPRT" render "$SCENES/$m" --accel "$a" --tree "$PERF/$s.$a.tree" --mode path --size "$GW" "$GH" \
+    "$BSPRT" render "$SCENES/$m" "${cam[@]}" --accel "$a" --tree "$PERF/$s.$a.tree" --mode path --size "$GW" "$GH" \
       --spp "$GALLERY_SPP" -o "$GAL/$s-path-$a.png" --json "$PERF/$s-path-$a.json" >/dev/null
-    "$BSPRT" render "$SCENES/$m" --accel "$a" --tree "$PERF/$s.$a.tree" --mode heat --heat-metric tests \
+    "$BSPRT" render "$SCENES/$m" "${cam[@]}" --accel "$a" --tree "$PERF/$s.$a.tree" --mode heat --heat-metric tests \
       --size "$GW" "$GH" -o "$GAL/$s-heat-tests-$a.png" >/dev/null
   done
-  "$BSPRT" render "$SCENES/$m" --accel embree --mode path --size "$GW" "$GH" --spp "$GALLERY_SPP" \
+  "$BSPRT" render "$SCENES/$m" "${cam[@]}" --accel embree --mode path --size "$GW" "$GH" --spp "$GALLERY_SPP" \
     -o "$PERF/$s-path-embree.png" --json "$PERF/$s-path-embree.json" >/dev/null
   rm -f "$PERF/$s.kd.tree" "$PERF/$s.bsp.tree" "$PERF/$s-path-embree.png"
 done
 
 # 7. docs/performance.md from the files above.
 GALLERY_LIST="${GALLERY[*]}" BENCH_CMD="bsprt ${BENCH_CMD[*]}" VERTEX_CMD="bsprt ${VERTEX_CMD[*]}" \
-  INSIDE_CMD="bsprt ${INSIDE_CMD[*]}" SMALL_CMD="bsprt ${SMALL_CMD[*]}" SCALING_CMD="bsprt ${SCALING_CMD[*]}" ELAPSED=$(($(date +%s) - start)) \
+  INSIDE_CMD="bsprt ${INSIDE_CMD[*]}" INTERIOR_CMD="bsprt ${INTERIOR_CMD[*]}" SMALL_CMD="bsprt ${SMALL_CMD[*]}" SCALING_CMD="bsprt ${SCALING_CMD[*]}" ELAPSED=$(($(date +%s) - start)) \
   SCENES="$SCENES" BUILD="$BUILD" GW="$GW" GH="$GH" SPP="$GALLERY_SPP" ERROR_COUNT="$ERROR_COUNT" \
   SCALING_LEVELS="$SCALING_LEVELS" \
   scripts/docs_write_performance.sh > docs/performance.md

@@ -161,6 +161,23 @@ $(error_table "$PERF/inside.csv" inside)
 
 $(speed_table "$PERF/inside.csv" inside)
 
+## Architecture seen from inside (sponza, conference)
+
+The scenes the paper's BSP is for: long, thin, slanted triangles seen from inside. Primary rays come
+from the interior cameras of \`bench/cameras.json\` (sponza's atrium, the conference room; the
+gallery below shows both views).
+
+\`${INTERIOR_CMD}\`
+
+### Primary rays (interior cameras)
+$(speed_table "$PERF/interior.csv" primary)
+
+### Random rays
+$(speed_table "$PERF/interior.csv" random)
+
+### Errors on vertex-aimed rays
+$(error_table "$PERF/interior.csv" vertex)
+
 ## Scaling with triangle count
 
 Build seconds and random-ray speed of bsp, kd and Embree on the meshes (from the run above) and on
@@ -211,6 +228,9 @@ $(cat "$PERF/vertex-bunny.md")
 
 ### Icospheres, inside and vertex rays
 $(cat "$PERF/inside.md")
+
+### Sponza and conference, interior cameras
+$(cat "$PERF/interior.md")
 
 ### Scaling
 $(cat "$PERF/scaling.md")

@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libopenmesh-dev                     # vectors, mesh IO
   libtbb-dev libcli11-dev libfmt-dev libstb-dev     # parallelism, CLI, formatting, PNG
   libembree-dev                                     # Embree 3: benchmark peer and test oracle
+  nlohmann-json3-dev                                # camera files (JSON)
   catch2 libbenchmark-dev                           # tests (Catch2 v2) and micro-benchmarks
   clang libclang-rt-dev                             # libFuzzer harnesses and sanitizers
   gnuplot-nox                                       # plots in docs/performance.md (scripts/docs.sh)
