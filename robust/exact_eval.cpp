@@ -18,14 +18,8 @@ namespace bsprt {
 namespace {
 
 using NT = CGAL::Mpzf;
-using V3 = std::array<NT, 3>;
+using V3 = Vec3<NT>;  // cross and dot: bsprt/vec3.h, written once over the number type
 
-V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-V3 cross3(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-NT dot3(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-V3 scale(const NT& s, const V3& a) { return {s * a[0], s * a[1], s * a[2]}; }
 V3 to_v3(const Vec3f& p) { return {NT(double(p.x)), NT(double(p.y)), NT(double(p.z))}; }
 
 /// Exact normal n and offset d (value = n·p + d) of a stored plane.
@@ -36,8 +30,7 @@ struct ExactPlane {
 
 ExactPlane exact_plane(const TriangleSoup& soup, PlaneDef p) {
   const PlaneFormula<NT> f = plane_formula<NT>(soup, p);
-  const V3 n = {f.n.x, f.n.y, f.n.z};
-  return {n, p.is_kd() ? NT(-double(p.coord())) : -dot3(n, to_v3(f.through))};
+  return {f.n, p.is_kd() ? NT(-double(p.coord())) : -dot(f.n, to_v3(f.through))};
 }
 
 /// Homogeneous intersection (N, D) of three planes: the point is N / D.
@@ -49,11 +42,11 @@ struct Homogeneous {
 Homogeneous intersect(const TriangleSoup& soup, const std::array<PlaneDef, 3>& def) {
   const ExactPlane a = exact_plane(soup, def[0]), b = exact_plane(soup, def[1]),
                    c = exact_plane(soup, def[2]);
-  const V3 bc = cross3(b.n, c.n), ca = cross3(c.n, a.n), ab = cross3(a.n, b.n);
+  const V3 bc = cross(b.n, c.n), ca = cross(c.n, a.n), ab = cross(a.n, b.n);
   Homogeneous h;
-  h.den = dot3(a.n, bc);
+  h.den = dot(a.n, bc);
   BSPRT_CHECK(!h.den.is_zero());  // three stored planes that do not meet in a point
-  const V3 s1 = scale(a.d, bc), s2 = scale(b.d, ca), s3 = scale(c.d, ab);
+  const V3 s1 = bc * a.d, s2 = ca * b.d, s3 = ab * c.d;
   for (int i = 0; i < 3; ++i) h.num[i] = -(s1[i] + s2[i] + s3[i]);
   return h;
 }
@@ -71,7 +64,7 @@ int exact_side_at(const TriangleSoup& soup, PlaneDef plane, const std::array<dou
 int exact_side_at(const TriangleSoup& soup, PlaneDef plane, const std::array<PlaneDef, 3>& def) {
   const Homogeneous h = intersect(soup, def);
   const ExactPlane e = exact_plane(soup, plane);
-  const NT v = dot3(e.n, h.num) + e.d * h.den;
+  const NT v = dot(e.n, h.num) + e.d * h.den;
   return sign_of(v) * sign_of(h.den);
 }
 
@@ -92,7 +85,7 @@ bool triangle_degenerate_exact(const TriangleSoup& soup, std::uint32_t t) {
   for (int k = 0; k < 3; ++k)
     if (!is_finite(soup.corner(t, k))) return true;
   const V3 p0 = to_v3(soup.corner(t, 0)), p1 = to_v3(soup.corner(t, 1)), p2 = to_v3(soup.corner(t, 2));
-  const V3 n = cross3(sub(p1, p0), sub(p2, p0));
+  const V3 n = cross(p1 - p0, p2 - p0);
   return n[0].is_zero() && n[1].is_zero() && n[2].is_zero();
 }
 

@@ -15,17 +15,12 @@ namespace bsprt {
 namespace {
 
 using IA = CGAL::Interval_nt<false>;
-using IV = std::array<IA, 3>;
-
-IV icross(const IV& a, const IV& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-IA idot(const IV& a, const IV& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using IV = Vec3<IA>;  // cross and dot: bsprt/vec3.h, written once over the number type
 
 /// Interval normal and exact reference point of a stored plane (plane_formula.h).
 void plane_normal(const TriangleSoup& soup, PlaneDef p, IV& n, std::array<double, 3>& ref) {
   const PlaneFormula<IA> f = plane_formula<IA>(soup, p);
-  n = {f.n.x, f.n.y, f.n.z};
+  n = f.n;
   ref = {double(f.through.x), double(f.through.y), double(f.through.z)};
 }
 
@@ -83,11 +78,11 @@ ExactPoint make_point(const RoundingGuard&, const TriangleSoup& soup, PlaneDef a
   const std::array<double, 3>& o = r[0];
   std::array<IA, 3> d;
   for (int i = 0; i < 3; ++i) {
-    const IV ro = {IA(r[i][0]) - o[0], IA(r[i][1]) - o[1], IA(r[i][2]) - o[2]};
-    d[i] = -idot(n[i], ro);
+    const IV ro(IA(r[i][0]) - o[0], IA(r[i][1]) - o[1], IA(r[i][2]) - o[2]);
+    d[i] = -dot(n[i], ro);
   }
-  const IV bc = icross(n[1], n[2]), ca = icross(n[2], n[0]), ab = icross(n[0], n[1]);
-  const IA den = idot(n[0], bc);
+  const IV bc = cross(n[1], n[2]), ca = cross(n[2], n[0]), ab = cross(n[0], n[1]);
+  const IA den = dot(n[0], bc);
   if (den.inf() > 0 || den.sup() < 0) {
     for (int i = 0; i < 3; ++i) {
       const IA x = o[i] + (-(d[0] * bc[i] + d[1] * ca[i] + d[2] * ab[i])) / den;

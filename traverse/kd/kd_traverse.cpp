@@ -145,13 +145,7 @@ Hit KdTracer::trace(const Ray& ray, RayCounters* counters) const {
 
 void KdTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
                            RayCounters* counters) const {
-  if (hits.size() != rays.size())
-    throw UsageError("trace_batch: " + std::to_string(rays.size()) + " rays but " +
-                     std::to_string(hits.size()) + " hits");
-  const Isa need = isa_for_width(packet_width);  // UsageError for bad widths
-  if (int(detected_isa()) < int(need))
-    throw UsageError("packets of " + std::to_string(packet_width) + " rays need " +
-                     isa_name(need) + ", this CPU has " + isa_name(detected_isa()));
+  const Isa need = check_trace_batch(rays.size(), hits.size(), packet_width);
   const KdView v{tree_.nodes.data(), tree_.prims.data(), triangles_.data(), tree_.bounds};
   switch (need) {
     case Isa::Scalar:

@@ -43,6 +43,16 @@ int isa_width(Isa isa) {
   return 1;
 }
 
+Isa check_trace_batch(std::size_t rays, std::size_t hits, int packet_width) {
+  if (hits != rays)
+    throw UsageError("trace_batch: " + std::to_string(rays) + " rays but " + std::to_string(hits) + " hits");
+  const Isa need = isa_for_width(packet_width);  // UsageError for bad widths
+  if (int(detected_isa()) < int(need))
+    throw UsageError("packets of " + std::to_string(packet_width) + " rays need " + isa_name(need) +
+                     ", this CPU has " + isa_name(detected_isa()));
+  return need;
+}
+
 Isa isa_for_width(int width) {
   switch (width) {
     case 1: return Isa::Scalar;

@@ -4,6 +4,7 @@
 /// kernel is compiled once per instruction set and the widest one this CPU
 /// supports is used, unless the user caps it (`--isa`).
 
+#include <cstddef>
 #include <string>
 
 namespace bsprt {
@@ -21,5 +22,9 @@ Isa parse_isa(const std::string& name);
 int isa_width(Isa isa);
 /// The ISA a packet of `width` rays needs (4 -> SSE4.2, 8 -> AVX2, 16 -> AVX-512).
 Isa isa_for_width(int width);
+/// The checks every packet-capable Accelerator::trace_batch makes: as many hits
+/// as rays, a packet width of 1, 4, 8 or 16 that this CPU can run. Returns the
+/// ISA the width needs; throws UsageError otherwise.
+Isa check_trace_batch(std::size_t rays, std::size_t hits, int packet_width);
 
 }  // namespace bsprt
