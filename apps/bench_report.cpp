@@ -4,6 +4,10 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+
+#include "builder/accel_factory.h"
+
 namespace bsprt {
 namespace {
 
@@ -75,7 +79,88 @@ std::string json_row(const BenchResult& res, const BenchRow& r) {
       bench_speed_ratio(res, r, "embree"));
 }
 
+/// The modes of the run, in first-seen order.
+std::vector<std::string> modes_of(const BenchResult& res) {
+  std::vector<std::string> out;
+  for (const BenchRow& r : res.rows)
+    if (std::find(out.begin(), out.end(), r.mode) == out.end()) out.push_back(r.mode);
+  return out;
+}
+
+const BenchRow* find_row(const std::vector<const BenchRow*>& g, const std::string& mode) {
+  for (const BenchRow* r : g)
+    if (r->mode == mode) return r;
+  return nullptr;
+}
+
 }  // namespace
+
+std::string bench_speed_summary(const BenchResult& res, const std::string& ray_set) {
+  const std::vector<std::string> modes = modes_of(res);
+  std::vector<std::string> bsp_modes, counted;  // BSP modes (ratios), modes with triangle counters
+  for (const std::string& m : modes) {
+    if (accel_info(m).tree == AccelTree::Bsp && !accel_info(m).certified) bsp_modes.push_back(m);
+    if (m == "kd" || (accel_info(m).tree == AccelTree::Bsp && !accel_info(m).certified)) counted.push_back(m);
+  }
+  const bool has_kd = std::find(modes.begin(), modes.end(), "kd") != modes.end();
+  const bool has_embree = std::find(modes.begin(), modes.end(), "embree") != modes.end();
+  std::string head = "| scene | triangles |", rule = "|---|---:|";
+  for (const std::string& m : modes) head += " " + m + " |", rule += "---:|";
+  for (const std::string& m : bsp_modes) {
+    if (has_kd) head += " **" + m + " / kd** |", rule += "---:|";
+    if (has_embree) head += " **" + m + " / embree** |", rule += "---:|";
+  }
+  const bool packets = std::find(modes.begin(), modes.end(), "bsp") != modes.end();
+  if (packets && has_kd) head += " bsp packets / kd packets |", rule += "---:|";
+  if (packets && has_embree) head += " bsp packets / embree packets |", rule += "---:|";
+  std::string tests_head;
+  for (const std::string& m : counted) tests_head += (tests_head.empty() ? "" : " → ") + m;
+  if (!counted.empty()) head += " tri tests/ray " + tests_head + " |", rule += "---:|";
+  std::string body;
+  for (const auto& g : groups(res)) {
+    if (g.front()->ray_set != ray_set) continue;
+    body += fmt::format("| {} | {} |", g.front()->scene, g.front()->triangles);
+    for (const std::string& m : modes) {
+      const BenchRow* r = find_row(g, m);
+      body += r ? fmt::format(" {:.2f} |", r->mrays_single) : std::string(" – |");
+    }
+    const auto ratio = [&](const std::string& m, const std::string& base, bool packet) {
+      const BenchRow *a = find_row(g, m), *b = find_row(g, base);
+      const double x = a ? (packet ? a->mrays_packet : a->mrays_single) : 0.0;
+      const double y = b ? (packet ? b->mrays_packet : b->mrays_single) : 0.0;
+      return " " + ratio_cell(x > 0 && y > 0 ? x / y : 0.0) + " |";
+    };
+    for (const std::string& m : bsp_modes) {
+      if (has_kd) body += ratio(m, "kd", false);
+      if (has_embree) body += ratio(m, "embree", false);
+    }
+    if (packets && has_kd) body += ratio("bsp", "kd", true);
+    if (packets && has_embree) body += ratio("bsp", "embree", true);
+    if (!counted.empty()) {
+      std::string tests;
+      for (const std::string& m : counted) {
+        const BenchRow* r = find_row(g, m);
+        tests += (tests.empty() ? "" : " → ") + (r ? fmt::format("{:.2f}", r->triangle_tests) : std::string("–"));
+      }
+      body += " " + tests + " |";
+    }
+    body += "\n";
+  }
+  return body.empty() ? std::string() : head + "\n" + rule + "\n" + body;
+}
+
+std::string bench_error_summary(const BenchResult& res, const std::string& ray_set) {
+  std::string body;
+  for (const BenchRow& r : res.rows)
+    if (r.ray_set == ray_set && r.error_rays > 0)
+      body += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} |\n", r.scene,
+                          r.mode, r.error_rays, r.error.lost, r.error.farther, r.error.extra, r.error.nearer,
+                          r.error.tie, r.error.max_t_ulps, r.median_t_ulps, leaks_per_million(r), ns_per_ray(r));
+  if (body.empty()) return {};
+  return "| scene | mode | rays checked | lost | farther (leaks) | extra | nearer | ties | max t ulps | median t ulps "
+         "| leaks+lost per M | ns/ray |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n" +
+         body;
+}
 
 double bench_speed_ratio(const BenchResult& result, const BenchRow& row, const std::string& base) {
   for (const BenchRow& b : result.rows)

@@ -25,6 +25,17 @@ std::string bench_json(const BenchResult& result);
 /// memory, error, and ratios vs kd and vs embree (when those modes ran).
 std::string bench_markdown(const BenchResult& result);
 
+/// Markdown summary of one ray set across scenes (what docs/performance.md
+/// shows): a row per scene with every mode's single-ray Mrays/s, each BSP mode
+/// against kd and Embree (single rays, and packets for bsp), and triangle tests
+/// per ray of kd and the BSP modes. Empty when the run has no such ray set.
+std::string bench_speed_summary(const BenchResult& result, const std::string& ray_set);
+
+/// Markdown: the error of every mode on one ray set, a row per scene and mode
+/// (rays checked, lost, farther, extra, nearer, ties, t ulps, leaks+lost per
+/// million, ns per ray). Empty when no row of that set was checked.
+std::string bench_error_summary(const BenchResult& result, const std::string& ray_set);
+
 /// Single-ray speed of `mode` over that of `base` on the same scene and ray
 /// set (0 when either is missing).
 double bench_speed_ratio(const BenchResult& result, const BenchRow& row, const std::string& base);

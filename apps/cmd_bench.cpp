@@ -79,8 +79,19 @@ void run(const BenchArgs& a) {
   write_file(dir / (a.prefix + ".md"), bench_markdown(result));
   write_file(dir / (a.prefix + ".csv"), bench_csv(result));
   write_file(dir / (a.prefix + ".json"), bench_json(result));
+  // The per-ray-set summaries docs/performance.md pastes in (scripts/docs.sh).
+  std::string summaries;
+  for (const std::string& set : o.ray_sets) {
+    const std::string speed = bench_speed_summary(result, set), error = bench_error_summary(result, set);
+    for (const auto& [kind, text] : {std::pair{"-speed-", speed}, std::pair{"-error-", error}}) {
+      if (text.empty()) continue;
+      write_file(dir / (a.prefix + kind + set + ".md"), text);
+      summaries += std::string(" ") + kind + set;
+    }
+  }
   print_summary(result);
-  fmt::print("wrote {0}.md, {0}.csv, {0}.json\n", (dir / a.prefix).string());
+  fmt::print("wrote {0}.md, {0}.csv, {0}.json{1}\n", (dir / a.prefix).string(),
+             summaries.empty() ? "" : " and summaries" + summaries + " (.md)");
 }
 
 }  // namespace

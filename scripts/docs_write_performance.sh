@@ -6,38 +6,9 @@ set -euo pipefail
 PERF=docs/perf
 GAL=docs/gallery
 
-# csv_table FILE RAYS MODES...: one line per scene, Mrays/s single of each mode,
-# then bsp/kd, bsp/embree, bsp-top/kd, bsp-top/embree, and triangle tests per ray
-# for kd, bsp and bsp-top.
-speed_table() {
-  local file=$1 rays=$2
-  awk -F, -v rays="$rays" '
-    NR == 1 { next }
-    $3 == rays { key = $1 SUBSEP $4; s[key] = $7; p[key] = $8; t[key] = $13; if (!($1 in seen)) { seen[$1] = 1; order[++n] = $1; tri[$1] = $2 } }
-    function r(a, b) { return (b > 0 && a > 0) ? sprintf("%.2f", a / b) : "–" }
-    END {
-      print "| scene | triangles | kd | bsp | bsp-top | bsp-zero-eps | bsp-certified | embree | embree-fast | **bsp / kd** | **bsp / embree** | **bsp-top / kd** | **bsp-top / embree** | bsp packets / kd packets | bsp packets / embree packets | tri tests/ray kd → bsp → bsp-top |"
-      print "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
-      for (i = 1; i <= n; ++i) {
-        sc = order[i]
-        printf "| %s | %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s | %s | %s | %s | %s | %.2f → %.2f → %.2f |\n", sc, tri[sc],
-          s[sc, "kd"], s[sc, "bsp"], s[sc, "bsp-top"], s[sc, "bsp-zero-eps"], s[sc, "bsp-certified"], s[sc, "embree"],
-          s[sc, "embree-fast"], r(s[sc, "bsp"], s[sc, "kd"]), r(s[sc, "bsp"], s[sc, "embree"]),
-          r(s[sc, "bsp-top"], s[sc, "kd"]), r(s[sc, "bsp-top"], s[sc, "embree"]), r(p[sc, "bsp"], p[sc, "kd"]),
-          r(p[sc, "bsp"], p[sc, "embree"]), t[sc, "kd"], t[sc, "bsp"], t[sc, "bsp-top"]
-      }
-    }' "$file"
-}
-
-# error_table FILE RAYS: per scene and mode, lost / farther / extra / nearer.
-error_table() {
-  awk -F, -v rays="$2" '
-    NR == 1 { next }
-    $3 == rays && $16 > 0 {
-      if (!hdr) { print "| scene | mode | rays checked | lost | farther (leaks) | extra | nearer | ties | max t ulps | median t ulps | leaks+lost per M | ns/ray |"; print "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"; hdr = 1 }
-      printf "| %s | %s | %d | %d | %d | %d | %d | %d | %.0f | %.1f | %.1f | %.1f |\n", $1, $4, $16, $17, $19, $18, $20, $21, $22, $23, $24, $25
-    }' "$1"
-}
+# summary FILE: a table `bsprt bench` wrote (PREFIX-speed-RAYS.md, PREFIX-error-RAYS.md;
+# apps/bench_report.h bench_speed_summary / bench_error_summary), or a note when the run had none.
+summary() { if [ -s "$1" ]; then cat "$1"; else echo "(no rows: $(basename "$1") was not written)"; fi; }
 
 # path_table: Mrays/s per thread and bounce of kd, bsp, embree for each gallery scene.
 path_table() {
@@ -90,18 +61,21 @@ subtrees of ≤ 1024 slots (single rays only; docs/certified-epsilons.md §10);
 **bsp-certified** certified epsilons and leaves decided exactly (filtered, CGAL fallback);
 **embree** Embree 3 robust mode; **embree-fast** Embree 3 default mode; **brute-certified** every
 triangle, decided exactly. Error is measured ray by ray against \`ExactTracer\` (CGAL exact
-ray/triangle intersection on the same float rays), in the vocabulary of DESIGN.md: *lost* (reference
+ray/triangle intersection on the same float rays), in the vocabulary of \`bsprt compare\`: *lost* (reference
 hits, mode misses), *farther* (a leak: the mode reports a surface behind the exact nearest one),
 *extra*, *nearer*, and |t − t_exact| in ulps. Speed: Mrays/s of all threads, best of 2 passes over the
-same rays; primary rays in 8×8 tiles.
+same rays, timing the traversal only (rays checked and output touched before; Embree through this
+harness runs within 2 % of a plain \`rtcIntersect1\` loop, docs/notes/2026-12-01-timing-harness.md);
+primary rays in 8×8 tiles. The tables are the summaries \`bsprt bench\` writes
+(\`docs/perf/PREFIX-speed-RAYS.md\`, \`PREFIX-error-RAYS.md\`).
 
 ## Key finding: rays aimed at the bunny's vertices (${vcount} rays)
 
 \`${VERTEX_CMD}\`
 
-$(error_table "$PERF/vertex-bunny.csv" vertex)
+$(summary "$PERF/vertex-bunny-error-vertex.md")
 
-DESIGN.md quotes 8 lost / 116 farther (robust) and 43 / 847 (default mode) for Embree on 100K such
+The project's design brief quotes 8 lost / 116 farther (robust) and 43 / 847 (default mode) for Embree on 100K such
 rays; the rows above are this run's own measurement on ${vcount} rays (a different ray set, so
 only the order of magnitude compares).
 
@@ -111,19 +85,19 @@ only the order of magnitude compares).
 
 ### Primary rays
 
-$(speed_table "$PERF/bench.csv" primary)
+$(summary "$PERF/bench-speed-primary.md")
 
 ### Random rays
 
-$(speed_table "$PERF/bench.csv" random)
+$(summary "$PERF/bench-speed-random.md")
 
 ### Vertex-aimed rays
 
-$(speed_table "$PERF/bench.csv" vertex)
+$(summary "$PERF/bench-speed-vertex.md")
 
 ### Edge-aimed rays
 
-$(speed_table "$PERF/bench.csv" edge)
+$(summary "$PERF/bench-speed-edge.md")
 
 ## Error against run time
 
@@ -138,17 +112,17 @@ PNG versions: [vertex](perf/error-vs-time-vertex.png), [edge](perf/error-vs-time
 
 ### Errors on vertex-aimed rays, all meshes
 
-$(error_table "$PERF/bench.csv" vertex)
+$(summary "$PERF/bench-error-vertex.md")
 
 ### Errors on edge-aimed rays, all meshes
 
-$(error_table "$PERF/bench.csv" edge)
+$(summary "$PERF/bench-error-edge.md")
 
 ### Errors on primary and random rays
 
-$(error_table "$PERF/bench.csv" primary)
+$(summary "$PERF/bench-error-primary.md")
 
-$(error_table "$PERF/bench.csv" random)
+$(summary "$PERF/bench-error-random.md")
 
 ## Rays from inside closed meshes
 
@@ -157,9 +131,9 @@ hits, so any lost hit is a leak through the surface.
 
 \`${INSIDE_CMD}\`
 
-$(error_table "$PERF/inside.csv" inside)
+$(summary "$PERF/inside-error-inside.md")
 
-$(speed_table "$PERF/inside.csv" inside)
+$(summary "$PERF/inside-speed-inside.md")
 
 ## Architecture seen from inside (sponza, conference)
 
@@ -170,13 +144,13 @@ gallery below shows both views).
 \`${INTERIOR_CMD}\`
 
 ### Primary rays (interior cameras)
-$(speed_table "$PERF/interior.csv" primary)
+$(summary "$PERF/interior-speed-primary.md")
 
 ### Random rays
-$(speed_table "$PERF/interior.csv" random)
+$(summary "$PERF/interior-speed-random.md")
 
 ### Errors on vertex-aimed rays
-$(error_table "$PERF/interior.csv" vertex)
+$(summary "$PERF/interior-error-vertex.md")
 
 ## Scaling with triangle count
 

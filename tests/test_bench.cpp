@@ -3,6 +3,7 @@
 // reference against itself has no error; the certified modes lose nothing).
 // Behaviour only, never timing.
 #include <catch2/catch.hpp>
+#include <fmt/core.h>
 
 #include <algorithm>
 #include <sstream>
@@ -141,4 +142,21 @@ TEST_CASE("bench: bad modes, ray sets and scenes are usage errors", "[bench]") {
   o.ray_sets = {"sideways"};
   CHECK_THROWS(run_bench({}, o));
   CHECK_THROWS(load_bench_scene("icosphere:x"));
+}
+
+TEST_CASE("bench: per-ray-set summaries hold a row per scene and the ratios of the run", "[bench]") {
+  const BenchResult& r = tiny_run();
+  const std::string speed = bench_speed_summary(r, "primary");
+  const std::vector<std::string> lines = split(speed, '\n');
+  REQUIRE(lines.size() == 3);  // header, rule, one scene
+  CHECK(lines[0].find("**bsp / kd**") != std::string::npos);
+  CHECK(lines[2].rfind("| icosphere-2 | 320 |", 0) == 0);
+  // The bsp / kd cell is the ratio of the two rows' single-ray speeds.
+  const double ratio = row("primary", "bsp").mrays_single / row("primary", "kd").mrays_single;
+  CHECK(lines[2].find(fmt::format(" {:.2f} |", ratio)) != std::string::npos);
+  CHECK(bench_speed_summary(r, "no-such-set").empty());
+  const std::vector<std::string> err = split(bench_error_summary(r, "vertex"), '\n');
+  REQUIRE(err.size() == 2 + 6);  // header, rule, a row per mode
+  CHECK(err[2].find("| icosphere-2 |") == 0);
+  CHECK(bench_error_summary(r, "no-such-set").empty());
 }
