@@ -110,6 +110,10 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
   INFO(b.output);
   REQUIRE(b.status == 0);
   CHECK(b.output.find("BSP (face/edge) splits") != std::string::npos);
+  // Long builds report their peak memory (getrusage): a positive number of MB.
+  const std::size_t pm = b.output.find("peak memory ");
+  REQUIRE(pm != std::string::npos);
+  CHECK(std::stod(b.output.substr(pm + 12)) > 0.0);
   const Run st = bsprt_cli("stats " + tree);
   REQUIRE(st.status == 0);
   CHECK(st.output.find("exact fallbacks") != std::string::npos);
