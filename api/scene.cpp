@@ -3,7 +3,6 @@
 /// with the CLI's checks and counts.
 #include "bsprt/scene.h"
 
-#include <cmath>
 #include <string>
 
 #include "builder/tree_file.h"
@@ -19,17 +18,6 @@ struct Scene::Impl {
   SceneSummary summary;
   std::uint64_t fingerprint = 0;
 };
-
-namespace {
-
-std::size_t unreferenced(const TriangleSoup& soup) {
-  std::vector<std::uint8_t> used(soup.vertices.size(), 0);
-  for (const TriIndices& t : soup.triangles)
-    for (std::uint32_t v : t) used[v] = 1;
-  return std::size_t(std::count(used.begin(), used.end(), std::uint8_t{0}));
-}
-
-}  // namespace
 
 Scene::Scene(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 
@@ -66,7 +54,7 @@ Scene Scene::from_arrays(std::span<const float> vertices, std::span<const std::u
     nonfinite += !finite;
   }
   const std::size_t degenerate = classify_degenerate(soup);
-  impl->summary = {"arrays", nv, unreferenced(soup), soup.size(), degenerate, nonfinite};
+  impl->summary = {"arrays", nv, soup.unreferenced_vertex_count(), soup.size(), degenerate, nonfinite};
   impl->fingerprint = scene_fingerprint(soup);
   return Scene(std::move(impl));
 }
@@ -87,7 +75,7 @@ Scene Scene::load(const std::string& path, const SceneOptions& options) {
 Scene Scene::default_scene() {
   auto impl = std::make_shared<Impl>();
   impl->soup = make_default_scene();
-  impl->summary = {"default", impl->soup.vertices.size(), unreferenced(impl->soup), impl->soup.size(),
+  impl->summary = {"default", impl->soup.vertices.size(), impl->soup.unreferenced_vertex_count(), impl->soup.size(),
                    impl->soup.degenerate_count(), 0};
   impl->fingerprint = scene_fingerprint(impl->soup);
   return Scene(std::move(impl));

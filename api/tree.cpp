@@ -6,8 +6,6 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <chrono>
-#include <fstream>
-#include <mutex>
 
 #include "builder/bsp/bsp_build.h"
 #include "builder/bsp/bsp_flat_io.h"
@@ -85,13 +83,7 @@ Tree Tree::load(const std::string& path, const Scene& scene) {
   return Tree(std::move(impl));
 }
 
-void Tree::save(const std::string& path) const {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw InputError(path, "cannot create tree file");
-  f.write(reinterpret_cast<const char*>(impl_->bytes.data()), std::streamsize(impl_->bytes.size()));
-  f.close();
-  if (!f) throw InputError(path, "cannot write tree file");
-}
+void Tree::save(const std::string& path) const { write_tree_file_image(path, impl_->bytes); }
 
 TreeKind Tree::kind() const { return impl_->reader->kind(); }
 std::span<const std::byte> Tree::bytes() const { return impl_->bytes; }

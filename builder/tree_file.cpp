@@ -114,8 +114,9 @@ std::vector<std::byte> TreeFileWriter::bytes() const {
   return out;
 }
 
-void TreeFileWriter::write(const std::string& path) const {
-  const std::vector<std::byte> out = bytes();
+void TreeFileWriter::write(const std::string& path) const { write_tree_file_image(path, bytes()); }
+
+void write_tree_file_image(const std::string& path, std::span<const std::byte> out) {
   std::ofstream f(path, std::ios::binary | std::ios::trunc);
   if (!f) throw InputError(path, "cannot create tree file");
   f.write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()));

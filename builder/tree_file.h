@@ -136,4 +136,7 @@ T TreeFileReader::record(std::uint32_t tag) const {
 /// The whole file at `path` (throws InputError when it cannot be read).
 std::vector<std::byte> read_tree_file_image(const std::string& path);
 
+/// Writes a file image (TreeFileWriter::bytes) to `path` (throws InputError when it cannot).
+void write_tree_file_image(const std::string& path, std::span<const std::byte> image);
+
 }  // namespace bsprt

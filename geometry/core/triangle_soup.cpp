@@ -19,6 +19,13 @@ Box3f TriangleSoup::bounds() const {
   return box;
 }
 
+std::size_t TriangleSoup::unreferenced_vertex_count() const {
+  std::vector<std::uint8_t> used(vertices.size(), 0);
+  for (const TriIndices& t : triangles)
+    for (std::uint32_t v : t) used[v] = 1;
+  return static_cast<std::size_t>(std::count(used.begin(), used.end(), std::uint8_t{0}));
+}
+
 std::size_t TriangleSoup::degenerate_count() const {
   return static_cast<std::size_t>(std::count_if(degenerate.begin(), degenerate.end(), [](std::uint8_t d) { return d != 0; }));
 }

@@ -38,6 +38,8 @@ struct TriangleSoup {
   Box3f bounds() const;
   /// Number of triangles flagged degenerate.
   std::size_t degenerate_count() const;
+  /// Number of vertices no triangle uses (they are kept, never looked at).
+  std::size_t unreferenced_vertex_count() const;
 };
 
 /// Appends every triangle of `b` (vertices re-indexed) to `a`.

@@ -315,12 +315,6 @@ std::size_t apply_nonfinite_policy(const std::string& path, const Polygons& p, c
   return count;
 }
 
-std::size_t count_unreferenced(const TriangleSoup& soup) {
-  std::vector<std::uint8_t> used(soup.vertices.size(), 0);
-  for (const TriIndices& t : soup.triangles)
-    for (std::uint32_t v : t) used[v] = 1;
-  return static_cast<std::size_t>(std::count(used.begin(), used.end(), std::uint8_t{0}));
-}
 
 }  // namespace
 
@@ -341,7 +335,7 @@ TriangleSoup load_mesh(const std::string& path, const LoadOptions& options, Load
   if (report) {
     report->format = ext;
     report->vertices = soup.vertices.size();
-    report->unreferenced_vertices = count_unreferenced(soup);
+    report->unreferenced_vertices = soup.unreferenced_vertex_count();
     report->faces = polygons.face_count();
     report->triangles = soup.triangles.size();
     report->degenerate = degenerate;

@@ -24,15 +24,15 @@ def test_scene_load_and_arrays(suzanne):
     assert all(a < b for a, b in zip(lo, hi))
     assert bsprt.Scene.load("default").fingerprint == bsprt.Scene.default().fingerprint
     # The same soup from arrays: one vertex triple per triangle.
-    tri = np.array([[s_c for s_c in corner] for corner in _corners(s)], dtype=np.float32)
+    tri = _corners(s)
     faces = np.arange(tri.shape[0], dtype=np.int64).reshape(-1, 3)
     a = bsprt.Scene(tri, faces)
     assert a.fingerprint == s.fingerprint
 
 
 def _corners(scene):
-    """Corner coordinates of every triangle, via a BSP-free route: the exact
-    reference's hits are not needed, the CLI's OBJ is parsed here."""
+    """Corner coordinates of every triangle, in triangle order, read from the
+    OBJ independently of bsprt's loader (fan triangulation, formats.md)."""
     verts, faces = [], []
     with open(scene.summary["source"]) as f:
         for line in f:

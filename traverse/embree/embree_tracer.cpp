@@ -209,7 +209,7 @@ inline Hit trace_checked(const EmbreeState& impl, const Ray& ray, RTCIntersectCo
 
 Hit EmbreeTracer::trace(const Ray& ray, RayCounters* counters) const {
   if (counters) ++counters->rays;
-  if (is_valid(ray)) check_embree_domain(ray, 0);
+  check_embree_domain(ray, 0);  // nullptr for invalid rays: they miss below
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   return trace_checked(*impl_, ray, &ctx);
