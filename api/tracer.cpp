@@ -28,12 +28,14 @@ std::string accel_for(TreeKind kind, std::string_view mode) {
     if (m == "float" || m == "kd") return "kd";
     throw UsageError("mode '" + m + "' is not a kd-tree mode (kd-trees trace in mode 'float')");
   }
-  if (m == "certified") return "bsp-certified";
-  if (m == "float") return "bsp";
-  if (m == "zero-eps" || m == "top" || m == "top-certified") return "bsp-" + m;
+  if (m == "certified") return "bsp";
+  if (m == "float") return "bsp-float";
+  if (m == "zero-eps") return "bsp-zero-eps";
+  if (m == "top" || m == "top-certified") return "bsp-top";  // top-certified: the name before exact leaves became the default
+  if (m == "top-float") return "bsp-top-float";
   if (accel_info(m).tree == AccelTree::Bsp) return m;  // throws UsageError for unknown names
   throw UsageError("mode '" + m +
-                   "' is not a BSP mode (certified, float, zero-eps, top, top-certified or a bsp* accelerator)");
+                   "' is not a BSP mode (certified, float, zero-eps, top, top-float or a bsp* accelerator)");
 }
 
 std::shared_ptr<Tracer::Impl> make(const Scene& scene, const std::string& accel, const Tree* tree) {

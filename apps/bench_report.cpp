@@ -99,9 +99,12 @@ std::string bench_speed_summary(const BenchResult& res, const std::string& ray_s
   const std::vector<std::string> modes = modes_of(res);
   std::vector<std::string> bsp_modes, counted;  // BSP modes (ratios), modes with triangle counters
   for (const std::string& m : modes) {
-    if (accel_info(m).tree == AccelTree::Bsp && !accel_info(m).certified) bsp_modes.push_back(m);
-    if (m == "kd" || (accel_info(m).tree == AccelTree::Bsp && !accel_info(m).certified)) counted.push_back(m);
+    if (accel_info(m).tree == AccelTree::Bsp && accel_info(m).packets) bsp_modes.push_back(m);
+    if (m == "kd" || (accel_info(m).tree == AccelTree::Bsp && accel_info(m).packets)) counted.push_back(m);
   }
+  // What exactness costs: the default (exact leaves) against the float leaf test.
+  const bool has_float = std::find(modes.begin(), modes.end(), "bsp-float") != modes.end() &&
+                         std::find(modes.begin(), modes.end(), "bsp") != modes.end();
   const bool has_kd = std::find(modes.begin(), modes.end(), "kd") != modes.end();
   const bool has_embree = std::find(modes.begin(), modes.end(), "embree") != modes.end();
   std::string head = "| scene | triangles |", rule = "|---|---:|";
@@ -113,6 +116,7 @@ std::string bench_speed_summary(const BenchResult& res, const std::string& ray_s
   const bool packets = std::find(modes.begin(), modes.end(), "bsp") != modes.end();
   if (packets && has_kd) head += " bsp packets / kd packets |", rule += "---:|";
   if (packets && has_embree) head += " bsp packets / embree packets |", rule += "---:|";
+  if (has_float) head += " bsp time / bsp-float time | packets |", rule += "---:|---:|";
   std::string tests_head;
   for (const std::string& m : counted) tests_head += (tests_head.empty() ? "" : " → ") + m;
   if (!counted.empty()) head += " tri tests/ray " + tests_head + " |", rule += "---:|";
@@ -136,6 +140,7 @@ std::string bench_speed_summary(const BenchResult& res, const std::string& ray_s
     }
     if (packets && has_kd) body += ratio("bsp", "kd", true);
     if (packets && has_embree) body += ratio("bsp", "embree", true);
+    if (has_float) body += ratio("bsp-float", "bsp", false) + ratio("bsp-float", "bsp", true);
     if (!counted.empty()) {
       std::string tests;
       for (const std::string& m : counted) {

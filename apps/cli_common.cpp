@@ -29,7 +29,7 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
       ->check(CLI::Range(1u, 1u << 27))
       ->capture_default_str();
   cmd.add_option("--single-rays", o.single_rays,
-                 "bsp, bsp-zero-eps: how single rays run: auto (interleaved for incoherent rays with tfar = inf), "
+                 "bsp, bsp-float, bsp-zero-eps: how single rays run: auto (interleaved for incoherent rays with tfar = inf), "
                  "sequential or interleaved; the hits are the same")
       ->check(CLI::IsMember({"auto", "sequential", "interleaved"}))
       ->capture_default_str();
@@ -87,9 +87,9 @@ std::vector<std::string> ignored_options(const TraceOptions& o) {
   const UsedOptions used = used_options(o);
   std::vector<std::string> ignored;
   if (o.single_rays != defaults.single_rays && !used.single_rays)
-    ignored.push_back("--single-rays (bsp, bsp-zero-eps only)");
+    ignored.push_back("--single-rays (bsp, bsp-float, bsp-zero-eps only)");
   if (o.top_slots != defaults.top_slots && !used.top_slots)
-    ignored.push_back("--top-slots (bsp-top, bsp-top-certified only)");
+    ignored.push_back("--top-slots (bsp-top, bsp-top-float only)");
   if (o.membership != defaults.membership && !used.membership)
     ignored.push_back(o.tree.empty() ? "--membership (BSP accelerators only)"
                                      : "--membership (a BSP built in memory only; the tree file fixed it when it was "

@@ -105,9 +105,10 @@ void run(const TraceArgs& a) {
                a.trace.accel, rays.size(), nhit, build_s, trace_s, mrays, a.trace.packets);
     if (a.stats)
       fmt::print(", \"per_ray\": {{\"kd_node_visits\": {:.4f}, \"bsp_node_visits\": {:.4f}, "
-                 "\"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}, \"box_node_visits\": {:.4f}}}",
+                 "\"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}, \"box_node_visits\": {:.4f}, "
+                 "\"rule_decisions\": {:.6f}, \"exact_decisions\": {:.6f}, \"exact_rays\": {:.6f}}}",
                  c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n,
-                 c.box_node_visits / n);
+                 c.box_node_visits / n, c.rule_decisions / n, c.exact_decisions / n, c.exact_rays / n);
     if (a.face_hits)
       fmt::print(", \"face_hits\": {{\"proven_hits\": {}, \"face_nodes\": {}, \"proving_nodes\": {}, "
                  "\"inner_nodes\": {}, \"seconds\": {:.3f}}}",
@@ -122,6 +123,10 @@ void run(const TraceArgs& a) {
     fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests{}\n",
                c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n,
                c.box_node_visits ? fmt::format(", {:.3f} box-top node visits", c.box_node_visits / n) : "");
+  if (a.stats && accel_info(a.trace.accel).certified)
+    fmt::print("exact leaf decisions per ray: {:.5f} by a rule on exact zeros, {:.5f} in exact arithmetic; "
+               "{} of {} rays ({:.4f} %) reached exact arithmetic\n",
+               c.rule_decisions / n, c.exact_decisions / n, c.exact_rays, rays.size(), 100.0 * c.exact_rays / n);
   if (a.face_hits) {
     fmt::print("face planes: {} of {} inner nodes split by a triangle's own face plane, {} with the cross-section "
                "inside that triangle (exact, {:.2f} s)\n",

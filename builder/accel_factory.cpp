@@ -49,13 +49,19 @@ std::unique_ptr<Accelerator> make_kd(const TriangleSoup& soup, const AccelOption
 class CertifiedBspTracer final : public Accelerator {
  public:
   /// top_slots > 0: under a box top of subtrees of at most that many slots.
-  CertifiedBspTracer(FlatBspTree flat, const TriangleSoup& soup, std::uint32_t top_slots = 0)
+  CertifiedBspTracer(FlatBspTree flat, const TriangleSoup& soup, std::uint32_t top_slots = 0,
+                     BspSingleRays single_rays = BspSingleRays::Auto)
       : exact_(soup), bsp_(std::move(flat), soup, BspEpsilon::Certified) {
     bsp_.set_exact_leaf(&exact_);
+    bsp_.set_single_rays(single_rays);
     if (top_slots > 0) add_box_top(bsp_, top_slots);
   }
   std::string name() const override { return bsp_.name(); }
   Hit trace(const Ray& ray, RayCounters* counters) const override { return bsp_.trace(ray, counters); }
+  void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
+                   RayCounters* counters) const override {
+    bsp_.trace_batch(rays, hits, packet_width, counters);
+  }
   std::size_t memory_bytes() const override { return bsp_.memory_bytes(); }
 
  private:
@@ -121,23 +127,24 @@ constexpr AccelInfo kTable[] = {
     {"embree-fast", "Embree 3, default mode", A::None, false, true, false, true, false, false,
      [](const TriangleSoup& s, const AccelOptions&) { return make_embree(s, false); }},
     {"kd", "SAH kd-tree, float watertight leaf test", A::Kd, false, true, false, false, false, false, make_kd},
-    {"bsp", "exact BSP, certified float traversal, watertight leaf test", A::Bsp, false, true, false, false, true,
-     false, [](const TriangleSoup& s, const AccelOptions& o) { return make_bsp(s, o, BspEpsilon::Certified); }},
-    {"bsp-certified", "exact BSP, certified traversal, exact-decision leaf test", A::Bsp, true, false, false, false,
-     false, false,
+    {"bsp", "exact BSP, certified traversal, exact-decision leaf test (the default)", A::Bsp, true, true, false,
+     false, true, false,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(s, o), s);
+       return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(s, o), s, 0, o.single_rays);
      }},
+    {"bsp-float", "exact BSP, certified float traversal, float watertight leaf test", A::Bsp, false, true, false,
+     false, true, false,
+     [](const TriangleSoup& s, const AccelOptions& o) { return make_bsp(s, o, BspEpsilon::Certified); }},
     {"bsp-zero-eps", "exact BSP traversed without the certified epsilons", A::Bsp, false, true, false, false, true,
      false, [](const TriangleSoup& s, const AccelOptions& o) { return make_bsp(s, o, BspEpsilon::Zero); }},
-    {"bsp-top", "the BSP under a 4-wide box top, single rays", A::Bsp, false, false, false, false, false, true,
+    {"bsp-top-float", "bsp-top with the float watertight leaf test", A::Bsp, false, false, false, false, false, true,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
        auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(s, o), s, BspEpsilon::Certified);
        add_box_top(*bsp, o.top_slots);
        return bsp;
      }},
-    {"bsp-top-certified", "bsp-top with the exact-decision leaf test", A::Bsp, true, false, false, false, false,
-     true,
+    {"bsp-top", "the BSP under a 4-wide box top, single rays, exact-decision leaf test", A::Bsp, true, false, false,
+     false, false, true,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
        return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(s, o), s, o.top_slots);
      }},
@@ -150,6 +157,11 @@ std::span<const AccelInfo> accel_table() { return kTable; }
 const AccelInfo& accel_info(std::string_view name) {
   for (const AccelInfo& a : kTable)
     if (a.name == name) return a;
+  // The names before exact leaves became the default (issue #23).
+  if (name == "bsp-certified" || name == "bsp-top-certified")
+    throw UsageError("accelerator '" + std::string(name) + "' is now '" + (name == "bsp-certified" ? "bsp" : "bsp-top") +
+                     "' (exact leaf decisions are the default; the float leaf test is '" +
+                     (name == "bsp-certified" ? "bsp-float" : "bsp-top-float") + "')");
   std::string names;
   for (const AccelInfo& a : kTable) names += (names.empty() ? "" : ", ") + std::string(a.name);
   throw UsageError("unknown accelerator '" + std::string(name) + "' (expected one of: " + names + ")");

@@ -4,9 +4,9 @@
 // common) and up to 16 rays aimed at pool vertices and edge points, some made
 // special (a direction component ±0, subnormal, huge, infinite or NaN; the
 // direction scaled by 2^-100 or 2^100; a segment starting behind the origin).
-// Builds brute, kd, bsp, bsp-certified, bsp-top and bsp-top-certified (box
+// Builds brute, kd, bsp-float, bsp (exact leaves), bsp-top-float and bsp-top (box
 // tops over one-slot subtrees) and the exact reference and traps when
-//   - bsp-certified or bsp-top-certified differ from the exact reference (lost,
+//   - bsp or bsp-top (exact leaves) differ from the exact reference (lost,
 //     extra, farther or nearer; a tie on another triangle at the same t is
 //     allowed), or
 //   - kd, bsp or bsp-top differ from brute force beyond ties: all run the same
@@ -133,6 +133,14 @@ void expect_packets_equal(const char* accel, const bsprt::Accelerator& t, std::s
                      w, i, double(single[i].t), single[i].prim, double(packed[i].t), packed[i].prim);
         __builtin_trap();
       }
+    // Uncounted: exact leaves run in the packet kernels only then (counted runs go single).
+    std::vector<bsprt::Hit> fast(rays.size());
+    t.trace_batch(rays, fast, w, nullptr);
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if (std::memcmp(&single[i], &fast[i], sizeof(bsprt::Hit)) != 0) {
+        std::fprintf(stderr, "%s uncounted packets of %d: ray %zu differs from single rays\n", accel, w, i);
+        __builtin_trap();
+      }
     if (cp.rays != cs.rays || cp.kd_node_visits != cs.kd_node_visits || cp.bsp_node_visits != cs.bsp_node_visits ||
         cp.leaf_visits != cs.leaf_visits || cp.triangle_tests != cs.triangle_tests) {
       std::fprintf(stderr, "%s packets of %d: counters differ from single rays\n", accel, w);
@@ -167,15 +175,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (rays.empty()) return 0;
   const std::vector<bsprt::Hit> exact = trace(*make("exact", soup), rays);
   const std::vector<bsprt::Hit> brute = trace(*make("brute", soup), rays);
-  expect_agree("bsp-certified vs exact", exact, trace(*make("bsp-certified", soup), rays));
+  expect_agree("bsp vs exact", exact, trace(*make("bsp", soup), rays));
   // Box tops of one-slot subtrees: every leaf under its own box, the deepest top.
-  expect_agree("bsp-top-certified vs exact", exact, trace(*make("bsp-top-certified", soup, 1), rays));
-  expect_agree("bsp-top vs brute", brute, trace(*make("bsp-top", soup, 1), rays));
-  const auto kd = make("kd", soup), bsp = make("bsp", soup);
+  expect_agree("bsp-top vs exact", exact, trace(*make("bsp-top", soup, 1), rays));
+  expect_agree("bsp-top-float vs brute", brute, trace(*make("bsp-top-float", soup, 1), rays));
+  const auto kd = make("kd", soup), bsp = make("bsp-float", soup);
   expect_agree("kd vs brute", brute, trace(*kd, rays));
-  expect_agree("bsp vs brute", brute, trace(*bsp, rays));
+  expect_agree("bsp-float vs brute", brute, trace(*bsp, rays));
   expect_packets_equal("kd", *kd, rays);
-  expect_packets_equal("bsp", *bsp, rays);
+  expect_packets_equal("bsp-float", *bsp, rays);
   expect_interleaved_equal(*bsp, rays);
+  expect_packets_equal("bsp", *make("bsp", soup), rays);  // exact leaves in the packet kernels
   return 0;
 }

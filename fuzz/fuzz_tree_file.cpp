@@ -85,8 +85,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   try_accel("kd", path);
   try_accel("bsp", path);
-  try_accel("bsp-certified", path);
+  try_accel("bsp-float", path);
   try_accel("bsp-top", path);
+  try_accel("bsp-top-float", path);
   std::remove(path.c_str());
   return 0;
 }

@@ -1,163 +1,298 @@
 #include "robust/certified_intersector.h"
 
-#include <CGAL/Exact_rational.h>
-#include <CGAL/Interval_nt.h>
+#include <CGAL/Mpzf.h>
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <limits>
 #include <optional>
-
-#include "robust/nearest_float.h"
 
 namespace bsprt {
 namespace {
 
-using Interval = CGAL::Interval_nt<false>;  // needs upward rounding: Protect_FPU_rounding
-using Rational = CGAL::Exact_rational;
+/// The exact stage's number type: a heap-free big float for the small
+/// magnitudes of float data (CGAL keeps 8 limbs inline; products of floats
+/// that span more than 512 bits of exponent are the only ones that allocate).
+using Mp = CGAL::Mpzf;
 
-/// The Plücker volumes and the t fraction of one ray/triangle pair, in NT.
-template <typename NT>
-struct Volumes {
-  NT u, v, w;  ///< weights of v0, v1, v2 (one sign on a hit)
-  NT num, den; ///< t = num / den
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+/// Relative bound of the double filter (docs/exact-leaf-test.md, "The double
+/// filter"): every quantity below is a sum of at most six monomials of degree
+/// three in float inputs, computed with at most 8 roundings of 2^-53 each on
+/// any path, so its error is below 8 * 2^-53 * (sum of |monomials|) * (1 + 2^-49).
+/// 2^-48 (32 roundings) leaves a wide margin for that and for the max-abs
+/// bound of the monomials, which is itself rounded.
+constexpr double kRel = 0x1p-48;
+
+struct D3 {
+  double x, y, z;
 };
+D3 dsub(const Vec3f& a, const Vec3f& b) {
+  return {double(a.x) - double(b.x), double(a.y) - double(b.y), double(a.z) - double(b.z)};
+}
+D3 dvec(const Vec3f& a) { return {double(a.x), double(a.y), double(a.z)}; }
+double dot(const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+D3 cross(const D3& a, const D3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double maxabs(const D3& a) { return std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)}); }
+/// (a x b) . d
+double triple(const D3& a, const D3& b, const D3& d) { return dot(cross(a, b), d); }
 
-template <typename NT>
-using V3 = std::array<NT, 3>;
-
-template <typename NT>
-V3<NT> lift(const Vec3f& p) { return {NT(double(p.x)), NT(double(p.y)), NT(double(p.z))}; }
-template <typename NT>
-V3<NT> sub(const V3<NT>& a, const V3<NT>& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-template <typename NT>
-NT dot(const V3<NT>& a, const V3<NT>& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-template <typename NT>
-NT triple(const V3<NT>& a, const V3<NT>& b, const V3<NT>& d) {  // (a x b) . d
-  return (a[1] * b[2] - a[2] * b[1]) * d[0] + (a[2] * b[0] - a[0] * b[2]) * d[1] + (a[0] * b[1] - a[1] * b[0]) * d[2];
+/// Whether a - b (floats) is exact in double: Knuth's two-sum error is zero.
+bool exact_difference(float a, float b) {
+  const double x = a, y = -double(b), s = x + y, yv = s - x, xv = s - yv;
+  return (x - xv) + (y - yv) == 0.0;
+}
+/// Whether a - o == ±d exactly (a vertex on the ray's line through o + d, or o - d).
+bool exactly_on_direction(const Vec3f& v, const Vec3f& o, const D3& a, const D3& d) {
+  const bool same = a.x == d.x && a.y == d.y && a.z == d.z, opposite = a.x == -d.x && a.y == -d.y && a.z == -d.z;
+  return (same || opposite) && exact_difference(v.x, o.x) && exact_difference(v.y, o.y) &&
+         exact_difference(v.z, o.z);
 }
 
-template <typename NT>
-Volumes<NT> volumes(const Ray& ray, const std::array<Vec3f, 3>& tri) {
-  const V3<NT> o = lift<NT>(ray.org), d = lift<NT>(ray.dir);
-  const V3<NT> a0 = sub(lift<NT>(tri[0]), o), a1 = sub(lift<NT>(tri[1]), o), a2 = sub(lift<NT>(tri[2]), o);
-  Volumes<NT> r{triple(a1, a2, d), triple(a2, a0, d), triple(a0, a1, d), NT(0), NT(0)};
-  r.num = r.u * dot(a0, d) + r.v * dot(a1, d) + r.w * dot(a2, d);
-  r.den = (r.u + r.v + r.w) * dot(d, d);
-  return r;
+struct M3 {
+  Mp x, y, z;
+};
+M3 msub(const Vec3f& a, const Vec3f& b) {
+  return {Mp(double(a.x)) - Mp(double(b.x)), Mp(double(a.y)) - Mp(double(b.y)), Mp(double(a.z)) - Mp(double(b.z))};
+}
+M3 mvec(const Vec3f& a) { return {Mp(double(a.x)), Mp(double(a.y)), Mp(double(a.z))}; }
+Mp mdot(const M3& a, const M3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+M3 mcross(const M3& a, const M3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+int msign(const Mp& x) { return int(x.sign()); }
+
+/// t = num / den exactly, den > 0 (the face-normal form n.(v0 - o) / n.d).
+struct ExactT {
+  Mp num, den;
+};
+ExactT exact_t(const Ray& ray, const std::array<Vec3f, 3>& tri) {
+  const M3 n = mcross(msub(tri[1], tri[0]), msub(tri[2], tri[0]));
+  ExactT e{mdot(n, msub(tri[0], ray.org)), mdot(n, mvec(ray.dir))};
+  if (msign(e.den) < 0) e.num = -e.num, e.den = -e.den;
+  return e;
+}
+/// sign(t - m) for a double m.
+int compare_t(const ExactT& e, double m) { return msign(e.num - Mp(m) * e.den); }
+
+/// The float nearest to the exact t (ties to even), with the enclosure
+/// [lo, hi] between the two midpoints around it; +inf when t rounds to
+/// infinity. No division: each step compares t with a midpoint of floats,
+/// which is a double.
+float round_exact(const ExactT& e, double& lo, double& hi) {
+  constexpr double kOverflow = 0x1.ffffffp127;  // FLT_MAX + half an ulp: ties to even go up to infinity
+  if (compare_t(e, kOverflow) >= 0) return kInf;
+  if (compare_t(e, -kOverflow) <= 0) return -kInf;
+  float f = float(e.num.to_double() / e.den.to_double());
+  if (!std::isfinite(f)) f = std::copysign(std::numeric_limits<float>::max(), f);
+  for (;;) {
+    const float down = std::nextafter(f, -kInf), up = std::nextafter(f, kInf);
+    const double m_lo = std::isfinite(down) ? (double(f) + double(down)) / 2 : -kOverflow;
+    const double m_hi = std::isfinite(up) ? (double(f) + double(up)) / 2 : kOverflow;
+    const int below = compare_t(e, m_lo), above = compare_t(e, m_hi);
+    if (below < 0) {
+      f = down;
+      continue;
+    }
+    if (above > 0) {
+      f = up;
+      continue;
+    }
+    lo = m_lo, hi = m_hi;
+    const auto odd = [](float x) { return (std::bit_cast<std::uint32_t>(x) & 1u) != 0; };
+    if (below == 0 && odd(f)) return down;  // ties to even
+    if (above == 0 && odd(f)) return up;
+    return f;
+  }
 }
 
-/// -1, 0, +1, or nullopt when the interval straddles zero.
-std::optional<int> sign_of(const Interval& x) {
-  if (x.inf() > 0) return 1;
-  if (x.sup() < 0) return -1;
-  if (x.inf() == 0 && x.sup() == 0) return 0;
-  return std::nullopt;
-}
+/// -1, 0, +1 from the double filter, or 2 when |x| <= bound.
+int filtered_sign(double x, double bound) { return x > bound ? 1 : (x < -bound ? -1 : 2); }
 
-/// One sign for all three volumes, not all zero: the line meets the triangle.
+/// One sign for all three weights, not all zero: the line meets the triangle.
 bool meets(int su, int sv, int sw) {
   const bool neg = su < 0 || sv < 0 || sw < 0, pos = su > 0 || sv > 0 || sw > 0;
   return !(neg && pos) && (neg || pos);
 }
+/// Two decided signs that differ: the line misses, whatever the third is.
+bool opposite(int a, int b) { return (a == 1 && b == -1) || (a == -1 && b == 1); }
 
-/// A hit of one triangle: t as an enclosure (a point when exact), and the
-/// exact value when it had to be computed.
+/// A hit of one triangle: the float t, an enclosure [t_lo, t_hi] of the
+/// exact t, the barycentrics and where on the triangle it lies.
 struct Candidate {
   double t_lo, t_hi;
-  std::optional<Rational> t_exact;
   float t, u, v;
+  std::uint8_t on = 0;  ///< NearestHit::on
+  Vec3f p, q;
 };
 
-Rational exact_t(const Ray& ray, const std::array<Vec3f, 3>& tri) {
-  const Volumes<Rational> e = volumes<Rational>(ray, tri);
-  return e.num / e.den;
+/// Decision counts of one call, added to the counters once.
+struct Stages {
+  std::uint64_t rule = 0, exact = 0;
+};
+
+/// Decides one triangle; nullopt = no hit with t in [tnear, tfar].
+std::optional<Candidate> test_one(const Ray& ray, const std::array<Vec3f, 3>& tri, Stages& st) {
+  // Double stage: the weights of v0, v1, v2 and their static error bounds.
+  const D3 d = dvec(ray.dir);
+  const D3 a0 = dsub(tri[0], ray.org), a1 = dsub(tri[1], ray.org), a2 = dsub(tri[2], ray.org);
+  const double m0 = maxabs(a0), m1 = maxabs(a1), m2 = maxabs(a2), md = maxabs(d);
+  double w[3] = {triple(a1, a2, d), triple(a2, a0, d), triple(a0, a1, d)};
+  int s[3] = {filtered_sign(w[0], 6 * kRel * (m1 * m2 * md)), filtered_sign(w[1], 6 * kRel * (m2 * m0 * md)),
+              filtered_sign(w[2], 6 * kRel * (m0 * m1 * md))};
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j)
+      if (opposite(s[i], s[j])) return std::nullopt;
+  if (s[0] == 2 || s[1] == 2 || s[2] == 2) {
+    // A vertex exactly on the ray's line through o + d: the two weights that
+    // pair it with d are triple products with a repeated vector, exactly 0.
+    const D3* a[3] = {&a0, &a1, &a2};
+    bool rule = false;
+    for (int i = 0; i < 3; ++i) {
+      if (!exactly_on_direction(tri[i], ray.org, *a[i], d)) continue;
+      for (int k = 0; k < 3; ++k)
+        if (k != i && s[k] == 2) s[k] = 0, w[k] = 0.0, rule = true;
+    }
+    if (s[0] == 2 || s[1] == 2 || s[2] == 2) {  // exact stage for what is still open
+      ++st.exact;
+      const M3 e0 = msub(tri[0], ray.org), e1 = msub(tri[1], ray.org), e2 = msub(tri[2], ray.org), ed = mvec(ray.dir);
+      const M3* e[3] = {&e0, &e1, &e2};
+      for (int k = 0; k < 3; ++k) {
+        if (s[k] != 2) continue;
+        const Mp x = mdot(mcross(*e[(k + 1) % 3], *e[(k + 2) % 3]), ed);
+        s[k] = msign(x);
+        w[k] = s[k] == 0 ? 0.0 : x.to_double();
+      }
+    } else if (rule) {
+      ++st.rule;
+    }
+  }
+  if (!meets(s[0], s[1], s[2])) return std::nullopt;
+
+  Candidate c;
+  const int zeros = int(s[0] == 0) + int(s[1] == 0) + int(s[2] == 0);
+  if (zeros == 2) {
+    c.on = 1;
+    c.p = tri[s[0] != 0 ? 0 : (s[1] != 0 ? 1 : 2)];
+  } else if (zeros == 1) {
+    const int k = s[0] == 0 ? 0 : (s[1] == 0 ? 1 : 2);  // the edge opposite vertex k
+    c.on = 2;
+    c.p = tri[(k + 1) % 3];
+    c.q = tri[(k + 2) % 3];
+  }
+  const double sum = w[0] + w[1] + w[2];
+  c.u = float(w[1] / sum);
+  c.v = float(w[2] / sum);
+
+  // t = n.(v0 - o) / n.d in double with its static bound.
+  const D3 f1 = dsub(tri[1], tri[0]), f2 = dsub(tri[2], tri[0]);
+  const D3 n = cross(f1, f2);
+  const double mn = 2 * maxabs(f1) * maxabs(f2);
+  double num = dot(n, a0), den = dot(n, d);
+  const double enum_ = 3 * kRel * (mn * m0), eden = 3 * kRel * (mn * md);
+  const double tnear = ray.tnear, tfar = ray.tfar;
+  bool decided = false;
+  if (std::abs(den) > eden) {
+    if (den < 0) num = -num, den = -den;
+    const double nl = num - enum_, nh = num + enum_, dl = den - eden, dh = den + eden;
+    double lo = nl >= 0 ? nl / dh : nl / dl, hi = nh >= 0 ? nh / dl : nh / dh;
+    lo -= std::abs(lo) * 0x1p-51;  // the division's rounding
+    hi += std::abs(hi) * 0x1p-51;
+    if (hi < tnear || lo > tfar) return std::nullopt;
+    if (lo >= tnear && hi <= tfar) {
+      const float fl = float(lo), fh = float(hi);
+      if (fl == fh) {
+        if (std::isinf(fl)) return std::nullopt;  // beyond the float range: a miss (docs/exact-leaf-test.md)
+        c.t = fl, c.t_lo = lo, c.t_hi = hi;
+        decided = true;
+      }
+    }
+  }
+  if (!decided) {
+    ++st.exact;
+    const ExactT e = exact_t(ray, tri);
+    if (std::isfinite(tnear) && compare_t(e, tnear) < 0) return std::nullopt;
+    if (std::isfinite(tfar) && compare_t(e, tfar) > 0) return std::nullopt;
+    c.t = round_exact(e, c.t_lo, c.t_hi);
+    if (std::isinf(c.t)) return std::nullopt;
+  }
+  return c;
+}
+
+bool same_point(const Vec3f& a, const Vec3f& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+/// Whether two triangles have the same three corners (in any order).
+bool same_corners(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b) {
+  for (const Vec3f& x : a)
+    if (!same_point(x, b[0]) && !same_point(x, b[1]) && !same_point(x, b[2])) return false;
+  for (const Vec3f& x : b)
+    if (!same_point(x, a[0]) && !same_point(x, a[1]) && !same_point(x, a[2])) return false;
+  return true;
+}
+
+/// Whether two hits have the same exact t for a reason that needs no
+/// arithmetic: the same vertex, the same edge, or triangles with the same corners.
+bool same_t_by_rule(const Candidate& c, const std::array<Vec3f, 3>& tri, const NearestHit& best,
+                    const std::array<Vec3f, 3>& best_tri) {
+  if (c.on == 1 && best.on == 1) return same_point(c.p, best.p);
+  if (c.on == 2 && best.on == 2)
+    return (same_point(c.p, best.p) && same_point(c.q, best.q)) || (same_point(c.p, best.q) && same_point(c.q, best.p));
+  return same_corners(tri, best_tri);
 }
 
 }  // namespace
 
 CertifiedIntersector::CertifiedIntersector(const TriangleSoup& soup) : soup_(soup) {}
 
-namespace {
-
-/// Decides one triangle; nullopt = no hit in [tnear, tfar]. Counts fallbacks.
-std::optional<Candidate> test_one(const Ray& ray, const std::array<Vec3f, 3>& tri, std::atomic<std::uint64_t>& fallbacks) {
-  std::optional<int> su, sv, sw;
-  double lo = 0, hi = 0, u = 0, v = 0;
-  {
-    CGAL::Protect_FPU_rounding<true> upward;
-    const Volumes<Interval> f = volumes<Interval>(ray, tri);
-    su = sign_of(f.u), sv = sign_of(f.v), sw = sign_of(f.w);
-    if (su && sv && sw && meets(*su, *sv, *sw)) {
-      const Interval t = f.num / f.den, sum = f.u + f.v + f.w;
-      lo = t.inf(), hi = t.sup();
-      u = CGAL::to_double(f.v / sum), v = CGAL::to_double(f.w / sum);
-    }
-  }
-  std::optional<Rational> t_exact;
-  if (!su || !sv || !sw) {  // the filter failed: decide exactly
-    fallbacks.fetch_add(1, std::memory_order_relaxed);
-    const Volumes<Rational> e = volumes<Rational>(ray, tri);
-    if (!meets(CGAL::sign(e.u), CGAL::sign(e.v), CGAL::sign(e.w))) return std::nullopt;
-    t_exact = e.num / e.den;
-    const Rational sum = e.u + e.v + e.w;
-    // to_double truncates: one double step each way encloses the exact t.
-    const double d = CGAL::to_double(*t_exact);
-    lo = std::nextafter(d, -INFINITY), hi = std::nextafter(d, INFINITY);
-    u = CGAL::to_double(e.v / sum), v = CGAL::to_double(e.w / sum);
-  } else if (!meets(*su, *sv, *sw)) {
-    return std::nullopt;
-  }
-  // t in [tnear, tfar], exactly.
-  const double tnear = ray.tnear, tfar = ray.tfar;
-  if (!t_exact && ((lo < tnear && hi >= tnear) || (lo <= tfar && hi > tfar))) {
-    fallbacks.fetch_add(1, std::memory_order_relaxed);
-    t_exact = exact_t(ray, tri);
-  }
-  if (t_exact) {
-    if (*t_exact < Rational(tnear) || (std::isfinite(tfar) && *t_exact > Rational(tfar))) return std::nullopt;
-    const float t = nearest_float(*t_exact);
-    return Candidate{lo, hi, t_exact, t, float(u), float(v)};
-  }
-  if (hi < tnear || lo > tfar) return std::nullopt;
-  // The float t: both ends round to the same float, else ask the exact value.
-  if (float(lo) != float(hi)) {
-    t_exact = exact_t(ray, tri);
-    return Candidate{lo, hi, t_exact, nearest_float(*t_exact), float(u), float(v)};
-  }
-  return Candidate{lo, hi, std::nullopt, float(lo), float(u), float(v)};
-}
-
-}  // namespace
-
-void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32_t> prims, NearestHit& best,
-                                     RayCounters* counters) const {
+void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32_t> prims,
+                                     const LeafTriangle* corners, NearestHit& best, RayCounters* counters) const {
   if (!is_valid(ray)) return;
-  for (const std::uint32_t prim : prims) {
+  Stages st;
+  for (std::size_t i = 0; i < prims.size(); ++i) {
+    const std::uint32_t prim = prims[i];
     if (counters) ++counters->triangle_tests;
     // The nearest triangle so far, met again in another leaf (a triangle is
     // listed in every leaf it touches): test_one is a function of the ray and
     // the triangle alone, so it would return the same candidate, which is not
-    // nearer than itself. Without this, the equal enclosures would send every
-    // such repeat to the exact comparison below (two rational t's).
+    // nearer than itself.
     if (best.hit.hit() && prim == best.hit.prim) continue;
-    const auto tri = soup_.corners(prim);
-    std::optional<Candidate> c = test_one(ray, tri, fallbacks_);
+    const std::array<Vec3f, 3> tri =
+        corners ? std::array<Vec3f, 3>{corners[i].v[0], corners[i].v[1], corners[i].v[2]} : soup_.corners(prim);
+    const std::optional<Candidate> c = test_one(ray, tri, st);
     if (!c) continue;
     bool nearer;
     if (!best.hit.hit() || c->t_hi < best.t_lo) {
       nearer = true;
     } else if (c->t_lo > best.t_hi) {
       nearer = false;
-    } else {  // enclosures overlap: compare the exact values
-      fallbacks_.fetch_add(1, std::memory_order_relaxed);
-      const Rational mine = c->t_exact ? *c->t_exact : exact_t(ray, tri);
-      const Rational theirs = exact_t(ray, soup_.corners(best.hit.prim));
-      nearer = mine < theirs || (mine == theirs && prim < best.hit.prim);
+    } else {  // enclosures overlap
+      const auto best_tri = soup_.corners(best.hit.prim);
+      int order;  // sign(t - best t)
+      if (same_t_by_rule(*c, tri, best, best_tri)) {
+        ++st.rule;
+        order = 0;
+      } else {
+        ++st.exact;
+        const ExactT mine = exact_t(ray, tri), theirs = exact_t(ray, best_tri);
+        order = msign(mine.num * theirs.den - theirs.num * mine.den);
+      }
+      nearer = order < 0 || (order == 0 && prim < best.hit.prim);
     }
     if (!nearer) continue;
     best.hit = Hit{c->t, prim, c->u, c->v};
     best.t_lo = c->t_lo;
     best.t_hi = c->t_hi;
+    best.on = c->on;
+    best.p = c->p;
+    best.q = c->q;
+  }
+  if (st.exact) fallbacks_.fetch_add(st.exact, std::memory_order_relaxed);
+  if (counters) {
+    counters->rule_decisions += st.rule;
+    counters->exact_decisions += st.exact;
   }
 }
 
@@ -167,9 +302,15 @@ CertifiedBruteTracer::CertifiedBruteTracer(const TriangleSoup& soup) : soup_(sou
 }
 
 Hit CertifiedBruteTracer::trace(const Ray& ray, RayCounters* counters) const {
-  if (counters) ++counters->rays;
   NearestHit best;
+  if (!counters) {
+    intersector_.intersect(ray, live_, best, nullptr);
+    return best.hit;
+  }
+  ++counters->rays;
+  const std::uint64_t before = counters->exact_decisions;
   intersector_.intersect(ray, live_, best, counters);
+  counters->exact_rays += counters->exact_decisions != before;
   return best.hit;
 }
 

@@ -1,17 +1,24 @@
 #pragma once
 /// \file certified_intersector.h
 /// Ray/triangle tests whose every decision is exact: hit or miss, t inside
-/// [tnear, tfar], and which of two hits is nearer. Filtered (docs/bsp-build.md,
-/// "Exact arithmetic scheme"): interval arithmetic (CGAL::Interval_nt)
-/// decides almost always; exact rationals (CGAL::Exact_rational) run only when
-/// an interval straddles zero, and are counted.
+/// [tnear, tfar], the float nearest to the exact t, and which of two hits is
+/// nearer. Staged (docs/exact-leaf-test.md):
+///  1. a double filter with a static error bound decides almost every test;
+///  2. rules on exact zeros decide what a filter never can: a vertex exactly on
+///     the ray's line (two weights are then exactly 0), and ties between hits
+///     at the same vertex, on the same edge or of triangles with the same corners;
+///  3. what is left is computed exactly in CGAL::Mpzf, without division and
+///     without rationals: signs of the weights, t against tnear and tfar, the
+///     rounding of t to float (comparisons with midpoints of floats), and two
+///     hits' t compared as num1 * den2 against num2 * den1.
 ///
 /// The test is Plücker-style: with A_i = v_i - o, the signed volumes
 /// U = (A1 x A2)·d, V = (A2 x A0)·d, W = (A0 x A1)·d have one sign when the
-/// line meets the triangle (zeros on its edges and corners); the hit point is
-/// (U A0 + V A1 + W A2)/(U+V+W) + o, so t = (U z0 + V z1 + W z2)/((U+V+W) d·d)
-/// with z_i = A_i·d. A ray lying in the triangle's plane (U = V = W = 0) does
-/// not hit it, as in the watertight test.
+/// line meets the triangle (zeros on its edges and corners), and
+/// t = n·A0 / n·d with n = (v1 - v0) x (v2 - v0) (n·d = U + V + W). A ray lying
+/// in the triangle's plane (U = V = W = 0) does not hit it, as in the
+/// watertight test. A hit whose exact t rounds to +inf, beyond the float
+/// range, is a miss, as in every mode (formats.md: a miss is t = +inf).
 
 #include <atomic>
 #include <cstdint>
@@ -28,11 +35,12 @@ class CertifiedIntersector final : public LeafIntersector {
  public:
   explicit CertifiedIntersector(const TriangleSoup& soup);
   std::string name() const override { return "certified"; }
-  void intersect(const Ray& ray, std::span<const std::uint32_t> prims, NearestHit& best,
-                 RayCounters* counters) const override;
+  using LeafIntersector::intersect;
+  void intersect(const Ray& ray, std::span<const std::uint32_t> prims, const LeafTriangle* corners,
+                 NearestHit& best, RayCounters* counters) const override;
 
-  /// Decisions the interval filter could not make, done in exact rationals
-  /// (all threads; rare, so one shared counter costs nothing).
+  /// Decisions the filter and the rules could not make, done in exact
+  /// arithmetic (all threads; one shared counter, added once per call).
   std::uint64_t exact_fallbacks() const { return fallbacks_.load(std::memory_order_relaxed); }
 
  private:

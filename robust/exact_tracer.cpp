@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -175,9 +176,13 @@ Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
     }
   }
   if (!best_t) return best;
+  // A hit beyond the float range (t rounds to +inf, or -inf when tnear = -inf) is a miss, in every mode
+  // (docs/exact-leaf-test.md, "Hits beyond the float range").
+  const float t_float = nearest_float(*best_t);
+  if (std::isinf(t_float)) return best;
   const auto [a, b, c] = impl_->soup.corners(best_prim);
   const auto [u, v] = barycentrics(*best_p, to_epeck(a), to_epeck(b), to_epeck(c));
-  best.t = nearest_float(*best_t);
+  best.t = t_float;
   best.prim = best_prim;
   best.u = u;
   best.v = v;

@@ -5,7 +5,9 @@
 /// certified leaf test (certified_intersector.cpp), so the two report the same
 /// float t for the same exact t.
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <CGAL/number_utils.h>
@@ -16,7 +18,8 @@ namespace bsprt {
 /// plus half an ulp (0x1.ffffffp127, where IEEE's ties-to-even goes to
 /// infinity) gives ±infinity; below it the result is finite. CGAL::to_double
 /// may be a double off (it truncates), so both float neighbours are checked.
-/// (A tie between two finite floats is not broken to even: no caller needs it.)
+/// A tie between two finite floats goes to the even one, as IEEE rounding does
+/// (the staged leaf test rounds the same way, certified_intersector.cpp).
 template <typename NT>
 float nearest_float(const NT& x) {
   constexpr double kOverflow = 0x1.ffffffp127;
@@ -30,7 +33,7 @@ float nearest_float(const NT& x) {
   for (const float f : {std::nextafter(f0, -kInf), std::nextafter(f0, kInf)}) {
     if (!std::isfinite(f)) continue;
     const NT e = CGAL::abs(NT(double(f)) - x);
-    if (e < err) best = f, err = e;
+    if (e < err || (e == err && (std::bit_cast<std::uint32_t>(f) & 1u) == 0)) best = f, err = e;
   }
   return best;
 }

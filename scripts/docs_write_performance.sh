@@ -53,12 +53,13 @@ Every number below is in the files of \`docs/perf/\` that the same run wrote.*
 | commit | ${commit} |
 | Embree | $(dpkg-query -W -f='${Version}' libembree-dev 2>/dev/null || echo "?") (Debian libembree-dev) |
 
-Modes (\`--accel\` names): **kd** SAH kd-tree; **bsp** exact BSP, float traversal with certified
-epsilons, watertight float triangle test (single rays: eight interleaved at a time when a block
-is incoherent and unbounded, not camera rays, docs/certified-epsilons.md §11); **bsp-top** the same tree under a 4-wide box top over
-subtrees of ≤ 1024 slots (single rays only; docs/certified-epsilons.md §10);
-**bsp-zero-eps** the same tree with all epsilons 0;
-**bsp-certified** certified epsilons and leaves decided exactly (filtered, CGAL fallback);
+Modes (\`--accel\` names): **kd** SAH kd-tree; **bsp** (the default) exact BSP, float traversal with certified
+epsilons, every leaf decision exact (double filter, rules on exact zeros, CGAL \`Mpzf\`; docs/exact-leaf-test.md);
+single rays run eight interleaved at a time when a block
+is incoherent and unbounded, not camera rays, docs/certified-epsilons.md §11; **bsp-float** the same with the
+watertight float triangle test; **bsp-top** the same tree under a 4-wide box top over
+subtrees of ≤ 1024 slots (single rays only, exact leaves; docs/certified-epsilons.md §10);
+**bsp-zero-eps** the same tree with all epsilons 0 and float leaves;
 **embree** Embree 3 robust mode; **embree-fast** Embree 3 default mode; **brute-certified** every
 triangle, decided exactly. Error is measured ray by ray against \`ExactTracer\` (CGAL exact
 ray/triangle intersection on the same float rays), in the vocabulary of \`bsprt compare\`: *lost* (reference

@@ -24,7 +24,7 @@ namespace bsprt::test {
 
 /// Every tracer of one scene, made from the accelerator table; `soup` must outlive it.
 struct ModeSet {
-  /// kd, bsp, bsp-certified, bsp-top and bsp-top-certified (box tops over
+  /// kd, bsp (exact leaves), bsp-float, bsp-top and bsp-top-float (box tops over
   /// 8-slot subtrees: many boxes even on small scenes) (+ embree when asked);
   /// the BSP modes share one build, handed to them as an in-memory tree file.
   std::vector<std::unique_ptr<Accelerator>> modes;
@@ -39,7 +39,7 @@ struct ModeSet {
     bsp.tree_file = std::make_shared<const TreeFileReader>(
         "(test: in-memory tree)", bsp_tree_file(soup, tree, flatten_bsp(soup, tree)).bytes());
     bsp.top_slots = 8;
-    for (const char* mode : {"bsp", "bsp-certified", "bsp-top", "bsp-top-certified"})
+    for (const char* mode : {"bsp-float", "bsp", "bsp-top-float", "bsp-top"})
       modes.push_back(make_tracer(mode, soup, bsp));
     if (with_embree) modes.push_back(make_tracer("embree", soup));
     if (std::getenv("BSPRT_STIFF_BRUTE")) modes.push_back(make_tracer("brute-certified", soup));

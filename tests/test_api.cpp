@@ -118,7 +118,7 @@ TEST_CASE("api: trees built or saved or loaded trace what the CLI traces", "[api
   const std::string path = test::scene_path("suzanne.obj");
   const Scene scene = Scene::load(path);
   for (const char* accel : {"bsp", "kd"}) {
-    const std::string mode = accel == std::string("bsp") ? "bsp-certified" : "kd";
+    const std::string mode = accel == std::string("bsp") ? "bsp" : "kd";
     const CliRun cli = cli_trace(path, std::string("trees-") + accel, "vertex", accel, mode);
     const std::vector<Ray> rays = read_rays(cli.rays);
     const std::vector<Hit> expected = read_hits(cli.hits);
@@ -217,8 +217,8 @@ TEST_CASE("api: every mode at every packet width and thread count gives the CLI'
   REQUIRE(test::bsprt_cli("gen-rays " + path + " --kind edge -n 3000 -o " + rays_path).status == 0);
   const std::vector<Ray> rays = read_rays(rays_path);
   const std::pair<const char*, const char*> modes[] = {
-      {"certified", "bsp-certified"}, {"float", "bsp"}, {"zero-eps", "bsp-zero-eps"}, {"top", "bsp-top"},
-      {"top-certified", "bsp-top-certified"}};
+      {"certified", "bsp"}, {"float", "bsp-float"}, {"zero-eps", "bsp-zero-eps"}, {"top", "bsp-top"},
+      {"top-float", "bsp-top-float"}, {"top-certified", "bsp-top"}};
   std::vector<Hit> ref(rays.size());
   const Tracer exact = Tracer::exact(scene);
   CHECK(exact.certified());

@@ -54,7 +54,7 @@ const BenchResult& tiny_run() {
     scenes.push_back(load_bench_scene("icosphere:2"));
     BenchOptions o;
     o.ray_sets = {"primary", "vertex", "inside"};
-    o.modes = {"exact", "brute-certified", "bsp-certified", "bsp", "kd", "embree"};
+    o.modes = {"exact", "brute-certified", "bsp", "bsp-float", "kd", "embree"};
     o.count = 1024;
     o.error_count = 300;
     o.threads = 2;
@@ -83,8 +83,9 @@ TEST_CASE("bench: one row per ray set and mode, with error measured", "[bench]")
     CHECK(row.error.rays == 300);
     CHECK(row.mrays_single > 0.0);
   }
-  CHECK(row("primary", "bsp").packet_width == r.packet_width);
-  CHECK(row("primary", "bsp-certified").packet_width == 1);
+  CHECK(row("primary", "bsp").packet_width == r.packet_width);  // exact leaves run in packets too
+  CHECK(row("primary", "bsp-float").packet_width == r.packet_width);
+  CHECK(row("primary", "brute-certified").packet_width == 1);
   CHECK(row("primary", "bsp").memory_bytes > 0);
   CHECK(row("primary", "bsp").triangle_tests > 0.0);
 }
@@ -97,8 +98,10 @@ TEST_CASE("bench: exact against itself has zero error; certified modes lose noth
     CHECK(e.error.tie == 0);
     CHECK(e.error.max_t_ulps == 0.0);
     CHECK(e.median_t_ulps == 0.0);
-    for (const std::string mode : {"bsp-certified", "brute-certified"}) {
+    for (const std::string mode : {"bsp", "brute-certified"}) {
       INFO(mode);
+      CHECK(row(set, mode).error.agrees());  // the default: nothing lost, extra, farther or nearer
+      CHECK(row(set, mode).error.tie == 0);   // and the same tie rule: the same triangle
       CHECK(row(set, mode).error.lost == 0);
       CHECK(row(set, mode).error.farther == 0);
     }

@@ -336,7 +336,7 @@ TEST_CASE("box top: shrunk boxes lose hits and the comparison sees it", "[bsp]")
     b.box.hi -= d;
   }
   tracer.set_box_top(build_box_top(boxes));
-  CHECK(tracer.name() == "bsp-top");
+  CHECK(tracer.name() == "bsp-top-float");
   const Comparison c = compare_with_brute(s.soup, tracer, all_ray_sets(s.soup, 300, 7));
   INFO("lost " << c.lost << ", farther " << c.farther << " of " << c.hits);
   CHECK(c.lost + c.farther > 0);
@@ -549,7 +549,7 @@ TEST_CASE("BSP: a direction scaled out of range by a power of two is traced at n
   const std::uint64_t base_visits = cb.kd_node_visits + cb.bsp_node_visits;
   REQUIRE(base_visits > 0);
   const std::unique_ptr<Accelerator> exact = make_tracer("exact", soup);
-  const std::unique_ptr<Accelerator> certified = make_tracer("bsp-certified", soup);
+  const std::unique_ptr<Accelerator> certified = make_tracer("bsp", soup);
   for (const float scale : {0x1p70f, 0x1p-70f, 0x1p100f, 0x1p-100f, 0x1p65f, 0x1p-65f}) {
     std::vector<Ray> rays = base;
     for (Ray& r : rays) {
@@ -603,7 +603,7 @@ TEST_CASE("BSP: a direction scaled out of range by a power of two is traced at n
     exact->trace_batch(rays, he, 1);
     certified->trace_batch(rays, hc, 1);
     const HitComparison x = compare_hits(he, hc);
-    INFO("bsp-certified vs exact: lost " << x.lost << ", extra " << x.extra << ", farther " << x.farther
+    INFO("bsp (exact leaves) vs exact: lost " << x.lost << ", extra " << x.extra << ", farther " << x.farther
                                          << ", nearer " << x.nearer);
     CHECK(x.agrees());
   }

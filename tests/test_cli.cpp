@@ -135,9 +135,9 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
     REQUIRE(r.status == 0);
     return read_hits(hits);
   };
-  const auto exact = trace("exact", ""), certified = trace("bsp-certified", "--tree " + tree);
-  const auto brute = trace("brute", ""), bsp = trace("bsp", "--tree " + tree), kd_hits = trace("kd", "--tree " + kd);
-  // The certified BSP equals the exact reference ray by ray.
+  const auto exact = trace("exact", ""), certified = trace("bsp", "--tree " + tree);
+  const auto brute = trace("brute", ""), bsp = trace("bsp-float", "--tree " + tree), kd_hits = trace("kd", "--tree " + kd);
+  // The default BSP (exact leaves) equals the exact reference ray by ray.
   const HitComparison c = compare_hits(exact, certified);
   CHECK(c.agrees());
   CHECK(c.tie == 0);
@@ -151,28 +151,32 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
       std::ifstream in(path, std::ios::binary);
       return std::string(std::istreambuf_iterator<char>(in), {});
     };
-    const std::string bsp_bytes = read_bytes(temp_path("cli_suzanne_bsp.hits"));
-    REQUIRE_FALSE(bsp_bytes.empty());
-    for (const char* how : {"sequential", "interleaved"}) {
-      const std::string out = temp_path(std::string("cli_suzanne_single_") + how + ".hits");
-      const Run r = bsprt_cli("trace " + scene + " " + rays + " -o " + out + " --accel bsp --tree " + tree +
-                              " --single-rays " + how);
-      INFO(r.output);
-      REQUIRE(r.status == 0);
-      CHECK(read_bytes(out) == bsp_bytes);
+    for (const char* accel : {"bsp", "bsp-float"}) {
+      const std::string bsp_bytes = read_bytes(temp_path(std::string("cli_suzanne_") + accel + ".hits"));
+      REQUIRE_FALSE(bsp_bytes.empty());
+      for (const char* how : {"sequential", "interleaved"}) {
+        for (const char* packets : {"1", "8"}) {
+          const std::string out = temp_path(std::string("cli_suzanne_single_") + how + ".hits");
+          const Run r = bsprt_cli("trace " + scene + " " + rays + " -o " + out + " --accel " + accel + " --tree " +
+                                  tree + " --single-rays " + how + " --packets " + packets);
+          INFO(accel << " " << how << " packets " << packets << ": " << r.output);
+          REQUIRE(r.status == 0);
+          CHECK(read_bytes(out) == bsp_bytes);
+        }
+      }
     }
     CHECK(bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp --single-rays fast")
               .status == 2);
   }
-  CHECK(bsprt_cli("compare " + temp_path("cli_suzanne_exact.hits") + " " + temp_path("cli_suzanne_bsp-certified.hits")).status == 0);
+  CHECK(bsprt_cli("compare " + temp_path("cli_suzanne_exact.hits") + " " + temp_path("cli_suzanne_bsp.hits")).status == 0);
 
   // Under a box top of small subtrees (many boxes), the same guarantees, and
   // --stats counts the box nodes.
-  const HitComparison ct = compare_hits(exact, trace("bsp-top-certified", "--tree " + tree + " --top-slots 4"));
+  const HitComparison ct = compare_hits(exact, trace("bsp-top", "--tree " + tree + " --top-slots 4"));
   CHECK(ct.agrees());
   CHECK(ct.tie == 0);
   CHECK(ct.max_t_ulps == 0);
-  CHECK(compare_hits(brute, trace("bsp-top", "--tree " + tree + " --top-slots 4")).agrees());
+  CHECK(compare_hits(brute, trace("bsp-top-float", "--tree " + tree + " --top-slots 4")).agrees());
   const Run ts = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp-top --tree " +
                            tree + " --stats");
   INFO(ts.output);
@@ -233,8 +237,13 @@ TEST_CASE("build --accel bsp with other SAH constants is certified and equals br
   REQUIRE(bsprt_cli("gen-rays " + scene + " --kind edge -n 2000 --seed 5 -o " + rays).status == 0);
   const std::string bh = temp_path("cli_costs_brute.hits"), th = temp_path("cli_costs_bsp.hits");
   REQUIRE(bsprt_cli("trace " + scene + " " + rays + " -o " + bh + " --accel brute").status == 0);
-  REQUIRE(bsprt_cli("trace " + scene + " " + rays + " -o " + th + " --accel bsp --tree " + tree).status == 0);
+  REQUIRE(bsprt_cli("trace " + scene + " " + rays + " -o " + th + " --accel bsp-float --tree " + tree).status == 0);
   CHECK(compare_hits(read_hits(bh), read_hits(th)).agrees());
+  // The default (exact leaves) on this tree equals the exact reference.
+  const std::string eh = temp_path("cli_costs_exact.hits"), xh = temp_path("cli_costs_bsp_exact.hits");
+  REQUIRE(bsprt_cli("trace " + scene + " " + rays + " -o " + eh + " --accel exact").status == 0);
+  REQUIRE(bsprt_cli("trace " + scene + " " + rays + " -o " + xh + " --accel bsp --tree " + tree).status == 0);
+  CHECK(compare_hits(read_hits(eh), read_hits(xh)).agrees());
 
   for (const std::string bad : {"--empty-bonus 0", "--empty-bonus 1.5", "--cost-isect -1", "--cost-kd 0"}) {
     const Run r = bsprt_cli("build " + scene + " -o " + temp_path("x.bsp") + " --accel bsp " + bad);
@@ -258,14 +267,14 @@ TEST_CASE("an option the chosen accelerator would ignore is a usage error", "[cl
     std::string options, message;
   };
   for (const Case& c : {Case{"--accel bsp-top --single-rays interleaved", "does not use --single-rays"},
-                        Case{"--accel bsp-top-certified --single-rays sequential", "does not use --single-rays"},
+                        Case{"--accel bsp-top-float --single-rays sequential", "does not use --single-rays"},
                         Case{"--accel embree --single-rays sequential", "does not use --single-rays"},
                         Case{"--accel bsp --top-slots 4", "does not use --top-slots"},
                         Case{"--accel kd --top-slots 4", "does not use --top-slots"},
                         Case{"--accel kd --membership closed", "does not use --membership"},
                         Case{"--accel bsp --tree " + tree + " --membership closed", "tree file fixed it"},
                         Case{"--accel brute --single-rays interleaved --top-slots 8",
-                             "does not use --single-rays (bsp, bsp-zero-eps only), --top-slots"}}) {
+                             "does not use --single-rays (bsp, bsp-float, bsp-zero-eps only), --top-slots"}}) {
     const Run r = trace(c.options);
     INFO(c.options << "\n" << r.output);
     CHECK(r.status == 2);
@@ -275,7 +284,7 @@ TEST_CASE("an option the chosen accelerator would ignore is a usage error", "[cl
   // The same options where they apply, and default values anywhere, are accepted.
   for (const std::string& ok :
        {std::string("--accel bsp --single-rays interleaved"), std::string("--accel bsp-zero-eps --single-rays sequential"),
-        std::string("--accel bsp-top --top-slots 4"), std::string("--accel bsp-top-certified --top-slots 4"),
+        std::string("--accel bsp-top --top-slots 4"), std::string("--accel bsp-top-float --top-slots 4"),
         std::string("--accel bsp --membership closed"), std::string("--accel embree --single-rays auto --top-slots 1024 --membership area")}) {
     const Run r = trace(ok);
     INFO(ok << "\n" << r.output);
@@ -352,4 +361,28 @@ TEST_CASE("stats and trace and verify reject a tree file whose header is corrupt
       CHECK(test::bsprt_cli("verify " + scene + " " + path).status == 1);
     }
   }
+}
+
+TEST_CASE("cli: exact leaves are the default; the old names say so; --stats counts the exact stages", "[cli]") {
+  const std::string scene = scene_path("suzanne.obj"), rays = temp_path("cli_default_exact.rays");
+  REQUIRE(bsprt_cli("gen-rays " + scene + " --kind vertex -n 2000 --seed 5 -o " + rays).status == 0);
+  for (const char* old : {"bsp-certified", "bsp-top-certified"}) {
+    const Run r = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel " + old);
+    INFO(r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find("is now 'bsp") != std::string::npos);
+  }
+  const Run s = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("cli_default_exact.hits") +
+                          " --accel bsp --stats");
+  INFO(s.output);
+  REQUIRE(s.status == 0);
+  CHECK(s.output.find("exact leaf decisions per ray") != std::string::npos);
+  CHECK(s.output.find("reached exact arithmetic") != std::string::npos);
+  const Run exact = bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("cli_default_ref.hits") +
+                              " --accel exact");
+  REQUIRE(exact.status == 0);
+  const HitComparison c = compare_hits(read_hits(temp_path("cli_default_ref.hits")),
+                                       read_hits(temp_path("cli_default_exact.hits")));
+  CHECK(c.agrees());
+  CHECK(c.tie == 0);
 }

@@ -11,6 +11,7 @@
 #include "geometry/io/load_mesh.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
+#include "traverse/brute_force.h"
 #include "stiff_util.h"
 #include "test_util.h"
 
@@ -62,7 +63,7 @@ TEST_CASE("tree file: a BSP plane that does not cut its cell is an InputError", 
   AccelOptions o;
   o.tree_path = dir + "/regressions/bsp_plane_not_cutting_cell.tree";
   CHECK_THROWS_AS(make_tracer("bsp", scene, o), InputError);
-  CHECK_THROWS_AS(make_tracer("bsp-certified", scene, o), InputError);
+  CHECK_THROWS_AS(make_tracer("bsp-float", scene, o), InputError);
 }
 
 // Found by fuzz_differential once its rays got special directions (a direction
@@ -146,19 +147,29 @@ TEST_CASE("mesh loader: a PLY ending on its end_header line is an InputError", "
 // (sanitizer build); Release builds reported FLT_MAX, while the certified leaf
 // test reported infinity. Both now round with robust/nearest_float.h, as IEEE
 // does: from FLT_MAX + half an ulp on, infinity; below, a finite float.
-TEST_CASE("exact reference: a hit beyond the float range rounds to infinity", "[regression]") {
+// Issue #23 then fixed one convention for every mode: a hit whose exact t
+// rounds to +inf is a miss (formats.md: a miss is t = +inf), as the float
+// modes always reported (docs/exact-leaf-test.md).
+TEST_CASE("exact reference: a hit beyond the float range is a miss in every mode", "[regression]") {
   TriangleSoup s;
   add_tri(s, {-1, -1, 1}, {3, -1, 1}, {-1, 3, 1});
   add_tri(s, {-1, -1, 0x1p100f}, {3, -1, 0x1p100f}, {-1, 3, 0x1p100f});
   const ExactTracer exact(s);
   const CertifiedBruteTracer certified(s);
+  const BruteForceTracer brute(s);
   const float inf = std::numeric_limits<float>::infinity();
-  for (const Accelerator* t : {static_cast<const Accelerator*>(&exact), static_cast<const Accelerator*>(&certified)}) {
-    // t = 1 / 1e-40, about 1e40: beyond every float.
+  for (const Accelerator* t : {static_cast<const Accelerator*>(&exact), static_cast<const Accelerator*>(&certified),
+                               static_cast<const Accelerator*>(&brute)}) {
+    CAPTURE(t->name());
+    // t = 1 / 1e-40, about 1e40: beyond every float, so a miss; the triangle
+    // at 2^100 is farther still.
     Hit h;
     REQUIRE_NOTHROW(h = t->trace(ray_of({0.25f, 0.25f, 0}, {0, 0, 1e-40f})));
-    CHECK(h.prim == 0);
+    CHECK(!h.hit());
     CHECK(h.t == inf);
+    // Behind the origin, the same magnitude: -infinity is below tnear = 0, so no hit.
+    CHECK(!t->trace(ray_of({0.25f, 0.25f, 0}, {0, 0, -1e-40f})).hit());
+    if (t == &brute) continue;  // the float test's own t overflows below: exact modes only
     // t = (2^100 - 2)·2^27, just below 2^127: large but finite, its nearest float is 2^127.
     REQUIRE_NOTHROW(h = t->trace(ray_of({0.25f, 0.25f, 2}, {0, 0, 0x1p-27f})));
     CHECK(h.prim == 1);

@@ -16,6 +16,13 @@ struct RayCounters {
   std::uint64_t leaf_visits = 0;      ///< leaves entered
   std::uint64_t triangle_tests = 0;   ///< ray/triangle tests run
   std::uint64_t box_node_visits = 0;  ///< 4-wide box nodes of a box top (bsp_boxtop.h)
+  /// Exact-decision leaf tests (robust/certified_intersector.h): decisions
+  /// the double filter could not make that a rule on exact zeros made (a ray
+  /// through a vertex, hits at one vertex, edge or triangle tied), decisions
+  /// made in exact arithmetic (CGAL::Mpzf), and rays with at least one of those.
+  std::uint64_t rule_decisions = 0;
+  std::uint64_t exact_decisions = 0;
+  std::uint64_t exact_rays = 0;
 
   RayCounters& operator+=(const RayCounters& o) {
     rays += o.rays;
@@ -24,6 +31,9 @@ struct RayCounters {
     leaf_visits += o.leaf_visits;
     triangle_tests += o.triangle_tests;
     box_node_visits += o.box_node_visits;
+    rule_decisions += o.rule_decisions;
+    exact_decisions += o.exact_decisions;
+    exact_rays += o.exact_rays;
     return *this;
   }
 };

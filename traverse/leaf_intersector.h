@@ -6,6 +6,7 @@
 /// enclosure of the best hit's exact t so that comparisons between hits, and
 /// the traversal's early exit, stay exact.
 
+#include <bit>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -23,6 +24,31 @@ struct NearestHit {
   Hit hit;
   double t_lo = std::numeric_limits<double>::infinity();
   double t_hi = std::numeric_limits<double>::infinity();
+  /// Where the best hit lies when an exact zero put it on a vertex or an edge
+  /// of its triangle: 0 inside (or not known), 1 at vertex p, 2 on edge pq.
+  /// Another triangle's hit at the same vertex, or on the same edge, has the
+  /// same exact t, which lets a tie be decided without exact arithmetic.
+  std::uint8_t on = 0;
+  Vec3f p, q;
+};
+
+/// The traversal's cull bound for an exact nearest hit: the smallest float at
+/// or above t_hi (+inf without a hit). The reported float t may lie below the
+/// exact t, and a cell entered between the two can still hold a nearer hit or
+/// a tie; culling against this bound never skips such a cell.
+inline float cull_bound(const NearestHit& best) {
+  if (!best.hit.hit()) return std::numeric_limits<float>::infinity();
+  const float f = float(best.t_hi);
+  if (!(double(f) < best.t_hi)) return f;
+  // The next float up, by its bits (t_hi is finite: f is at most FLT_MAX).
+  const std::uint32_t b = std::bit_cast<std::uint32_t>(f);
+  if (f == 0.0f) return std::numeric_limits<float>::denorm_min();
+  return std::bit_cast<float>(f > 0.0f ? b + 1u : b - 1u);
+}
+
+/// A triangle as a traversal stores it beside its leaves: its three corners.
+struct LeafTriangle {
+  Vec3f v[3];
 };
 
 /// Tests leaf triangles with exact decisions; thread-safe, stateless per call.
@@ -34,8 +60,16 @@ class LeafIntersector {
   /// Tests the triangles `prims` (triangle numbers of the scene it was made
   /// for) against `ray`, keeping the exactly nearest one in `best` (exact ties
   /// go to the lower triangle number). Counts triangle_tests when non-null.
-  virtual void intersect(const Ray& ray, std::span<const std::uint32_t> prims, NearestHit& best,
-                         RayCounters* counters) const = 0;
+  /// `corners`, when non-null, holds the corners of prims[i] at corners[i]
+  /// (the traversal's own copy, read in leaf order); else the intersector
+  /// reads them from its scene.
+  virtual void intersect(const Ray& ray, std::span<const std::uint32_t> prims, const LeafTriangle* corners,
+                         NearestHit& best, RayCounters* counters) const = 0;
+  /// As above, corners from the scene.
+  void intersect(const Ray& ray, std::span<const std::uint32_t> prims, NearestHit& best,
+                 RayCounters* counters) const {
+    intersect(ray, prims, nullptr, best, counters);
+  }
 };
 
 }  // namespace bsprt

@@ -35,9 +35,10 @@ class Tracer {
   /// Traces `tree` (built for `scene`) in `mode`:
   ///  - BSP trees: "certified" (default; exact-decision leaf test, hits equal the
   ///    exact reference's), "float" (certified epsilons, float watertight leaf),
-  ///    "zero-eps", "top", "top-certified";
+  ///    "zero-eps" (float leaves without the epsilons), "top" (a box top over
+  ///    the BSP, exact leaves), "top-float"; "top-certified" is "top";
   ///  - kd-trees: "float".
-  /// Any `--accel` name of that tree kind (e.g. "bsp-certified") is accepted too.
+  /// Any `--accel` name of that tree kind (e.g. "bsp-float") is accepted too.
   /// Throws UsageError for a mode the tree kind has not.
   Tracer(const Scene& scene, const Tree& tree, std::string_view mode = "certified");
 
@@ -49,7 +50,7 @@ class Tracer {
   /// The `--accel` names by_name accepts.
   static std::vector<std::string> accelerators();
 
-  /// The accelerator's `--accel` name ("bsp-certified", "kd", "exact", ...).
+  /// The accelerator's `--accel` name ("bsp", "bsp-float", "kd", "exact", ...).
   std::string name() const;
   /// True when every hit equals the exact reference's, bit for bit.
   bool certified() const;

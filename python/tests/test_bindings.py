@@ -12,7 +12,7 @@ from conftest import cli
 def test_version_and_accelerators():
     assert bsprt.__version__.count(".") == 2
     names = bsprt.Tracer.accelerators()
-    assert {"bsp", "bsp-certified", "kd", "exact", "embree"} <= set(names)
+    assert {"bsp", "bsp-float", "kd", "exact", "embree"} <= set(names)
 
 
 def test_scene_load_and_arrays(suzanne):
@@ -88,8 +88,9 @@ def test_bad_files_raise_input_error(tmp_path, scenes):
         bsprt.read_rays(str(bad))
 
 
-@pytest.mark.parametrize("accel,mode,cli_mode", [("bsp", "certified", "bsp-certified"), ("bsp", "float", "bsp"),
-                                                 ("bsp", "top", "bsp-top"), ("kd", "float", "kd")])
+@pytest.mark.parametrize("accel,mode,cli_mode", [("bsp", "certified", "bsp"), ("bsp", "float", "bsp-float"),
+                                                 ("bsp", "top", "bsp-top"), ("bsp", "top-float", "bsp-top-float"),
+                                                 ("kd", "float", "kd")])
 def test_trace_equals_cli(tmp_path, suzanne, accel, mode, cli_mode):
     rays_path, tree_path, hits_path = tmp_path / "r.rays", tmp_path / "t.tree", tmp_path / "h.hits"
     cli("gen-rays", suzanne, "--kind", "vertex", "-n", 3000, "-o", rays_path)

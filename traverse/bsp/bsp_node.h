@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bsprt/vec3.h"
+#include "traverse/leaf_intersector.h"
 
 namespace bsprt {
 
@@ -128,9 +129,7 @@ struct FlatBspTree {
 
 /// A triangle's corners, copied by tracers in leaf order so a leaf's triangles
 /// are contiguous in memory (36 bytes each).
-struct BspTriangle {
-  Vec3f v[3];
-};
+using BspTriangle = LeafTriangle;
 
 /// Figures of a flat BSP tree (reports, `bsprt stats`, docs).
 struct FlatBspStats {

@@ -16,8 +16,10 @@
 /// sequence of nodes and leaves: hits and counters equal single rays exactly.
 /// Raw arrays only: no std:: templates are instantiated for this ISA.
 
+#include <bit>
 #include <cstdint>
 #include <limits>
+#include <span>
 
 #include "traverse/bsp/bsp_kernel.h"
 #include "traverse/simd/watertight_packet.h"
@@ -96,6 +98,25 @@ inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count
   return p;
 }
 
+/// The exact leaf test (v.exact_leaf) for each active lane, one ray at a time:
+/// the lane's NearestHit keeps the exact order and the answer, hit.t its
+/// cull bound (cull_bound).
+/// Counted runs trace single rays (BspTracer::trace_batch), so no counters here.
+template <int W>
+inline void packet_exact_leaf(const BspView& v, const CompactBspSlot& n, const Ray* rays, NearestHit* nearest,
+                              PacketHit<W>& hit, vmask<W> active) {
+  const std::uint32_t first = n.prim_offset();
+  const std::span<const std::uint32_t> prims(v.prims + first, n.prim_count());
+  alignas(64) float t[W];
+  store<W>(t, hit.t);
+  for (unsigned m = movemask<W>(active); m != 0; m &= m - 1) {
+    const int lane = std::countr_zero(m);
+    v.exact_leaf->intersect(rays[lane], prims, v.triangles + first, nearest[lane], nullptr);
+    t[lane] = cull_bound(nearest[lane]);
+  }
+  hit.t = load<W>(t);
+}
+
 template <int W, bool kCount>
 inline void packet_leaf(const BspView& v, const CompactBspSlot& n, const WatertightPacket<W>& pre,
                         PacketHit<W>& hit, vmask<W> active, RayCounters* c) {
@@ -129,7 +150,8 @@ inline vmask<W> cut_node(const CompactBspSlot& n, const BspPacketRay<W>& r, vflo
 /// precomputation is made at the first leaf: most packets of a camera that
 /// frames the scene never reach one.
 template <int W, bool kCount>
-void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit, RayCounters* c) {
+void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit, RayCounters* c,
+                  const Ray* rays = nullptr, NearestHit* nearest = nullptr) {
   WatertightPacket<W> pre;
   bool have_pre = false;
   vfloat<W> tmin = r.tmin, tmax = r.tmax;
@@ -189,7 +211,9 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
       }
       n = &v.nodes[node];
     }
-    if (leaf) {
+    if (leaf && nearest) {
+      packet_exact_leaf<W>(v, *n, rays, nearest, hit, active);
+    } else if (leaf) {
       if (!have_pre) {
         pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
         have_pre = true;
@@ -219,6 +243,12 @@ void trace_packets(const BspView& v, const Ray* rays, std::size_t n, Hit* hits, 
     const BspPacketRay<W> r = packet_setup<W>(v, rays + base, count);
     if constexpr (kCount) c->rays += std::uint64_t(count);
     PacketHit<W> hit = packet_miss<W>();
+    if (v.exact_leaf) {  // exact leaves: never counted here (see packet_exact_leaf)
+      NearestHit nearest[W];
+      if (any<W>(r.live)) trace_packet<W, false>(v, r, hit, nullptr, rays + base, nearest);
+      for (int i = 0; i < count; ++i) hits[base + std::size_t(i)] = nearest[i].hit;
+      continue;
+    }
     if (any<W>(r.live)) trace_packet<W, kCount>(v, r, hit, c);
     store_hits<W>(hit, std::span<Hit>(hits + base, std::size_t(count)));
   }

@@ -31,16 +31,18 @@ constexpr int kTopStackSize = 3 * 64 + 4;
 using detail::StackEntry;
 
 /// Tests the triangles of a leaf (ties keep the earlier triangle). With an
-/// exact leaf test, `nearest` keeps the exact order and hit mirrors it.
+/// exact leaf test, `nearest` keeps the exact order and the answer; hit then
+/// holds its prim and, as t, the cull bound (cull_bound).
 template <bool kCount>
 inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray& ray, const WatertightRay& wr,
                            Hit& hit, NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if constexpr (kCount) ++c->leaf_visits;
   if (v.exact_leaf) {
-    v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, n.prim_count()), nearest,
-                            kCount ? c : nullptr);
-    hit = nearest.hit;
+    v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, n.prim_count()),
+                            v.triangles + first, nearest, kCount ? c : nullptr);
+    hit.prim = nearest.hit.prim;
+    hit.t = cull_bound(nearest);
     return;
   }
   if constexpr (kCount) c->triangle_tests += n.prim_count();
@@ -117,8 +119,14 @@ inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& wa
   if (!rc.live) return hit;
   const WatertightRay wr = watertight_precompute(ray);
   NearestHit nearest;
-  walk(rc, wr, hit, nearest);
-  return hit;
+  if constexpr (kCount) {
+    const std::uint64_t before = c->exact_decisions;  // set by an exact leaf test
+    walk(rc, wr, hit, nearest);
+    c->exact_rays += c->exact_decisions != before;
+  } else {
+    walk(rc, wr, hit, nearest);
+  }
+  return v.exact_leaf ? nearest.hit : hit;
 }
 
 /// One ray through the whole tree.
@@ -248,6 +256,7 @@ struct Lane {
   BspRayConst rc;
   WatertightRay wr;
   Hit hit;
+  NearestHit nearest;  ///< exact leaf tests only
   const Ray* ray;
   std::size_t index;  ///< slot in hits; kIdle: no ray left for this lane
   std::uint32_t node;
@@ -287,10 +296,7 @@ inline bool lane_step(const BspView& v, Lane& L) {
     L.pop = (go_near | go_far) ^ 1u;
     return false;
   }
-  if (L.pop == 0) {
-    NearestHit unused;  // float leaves only
-    intersect_leaf<false>(v, *n, *L.ray, L.wr, L.hit, unused, nullptr);
-  }
+  if (L.pop == 0) intersect_leaf<false>(v, *n, *L.ray, L.wr, L.hit, L.nearest, nullptr);
   const float best = detail::hit_bound(L.rc, L.hit.t);
   for (;;) {
     if (L.sp == 0) return true;
@@ -324,6 +330,7 @@ void trace_interleaved(const BspView& v, const Ray* rays, std::size_t count, Hit
       }
       L.wr = watertight_precompute(rays[i]);
       L.hit = Hit{};
+      L.nearest = NearestHit{};
       L.ray = &rays[i];
       L.index = i;
       L.node = 0;
@@ -343,7 +350,7 @@ void trace_interleaved(const BspView& v, const Ray* rays, std::size_t count, Hit
   while (active > 0) {
     for (Lane& L : lanes) {
       if (L.index == kIdle || !lane_step(v, L)) continue;
-      hits[L.index] = L.hit;
+      hits[L.index] = v.exact_leaf ? L.nearest.hit : L.hit;
       start(L);
       active -= L.index == kIdle;
     }
@@ -434,9 +441,10 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
                             RayCounters* counters) const {
   const Isa need = check_trace_batch(rays.size(), hits.size(), packet_width);
   const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
-  // Exact leaves and box tops trace single rays.
-  if (need == Isa::Scalar || tree_.bounds.empty() || exact_leaf_ || has_top_) {
-    const bool interleave = !counters && !exact_leaf_ && !has_top_ && !tree_.bounds.empty() &&
+  // Box tops trace single rays, and so do exact leaves when counted (the
+  // packet kernels count no exact decisions; the counts are the same).
+  if (need == Isa::Scalar || tree_.bounds.empty() || (exact_leaf_ && counters) || has_top_) {
+    const bool interleave = !counters && !has_top_ && !tree_.bounds.empty() &&
                             (single_rays_ == BspSingleRays::Interleaved ||
                              (single_rays_ == BspSingleRays::Auto && !rays_look_coherent(rays) &&
                               rays_unbounded(rays)));

@@ -70,15 +70,16 @@ class BspTracer final : public Accelerator {
   /// was built for a scene with another triangle count.
   BspTracer(FlatBspTree tree, const TriangleSoup& soup, BspEpsilon mode = BspEpsilon::Certified);
 
-  /// bsp, bsp-certified, bsp-zero-eps; with a box top bsp-top, bsp-top-certified, bsp-top-zero-eps.
+  /// bsp (exact leaves), bsp-float, bsp-zero-eps; with a box top bsp-top,
+  /// bsp-top-float, bsp-top-zero-eps.
   std::string name() const override {
-    const std::string base = exact_leaf_ ? "bsp-certified" : (mode_ == BspEpsilon::Zero ? "bsp-zero-eps" : "bsp");
+    const std::string base = exact_leaf_ ? "bsp" : (mode_ == BspEpsilon::Zero ? "bsp-zero-eps" : "bsp-float");
     return has_top_ ? "bsp-top" + base.substr(3) : base;
   }
   /// Tests leaves with `exact` (exact decisions, robust/certified_intersector.h)
   /// instead of the float watertight test; it must outlive the tracer. With
   /// certified epsilons this makes every decision exact: the nearest hit equals
-  /// the exact reference's. Packets then run as single rays.
+  /// the exact reference's. Packets run the exact test lane by lane.
   void set_exact_leaf(const LeafIntersector* exact) { exact_leaf_ = exact; }
   /// Single ray, front to back; counts bsp_node_visits, kd_node_visits,
   /// leaf_visits, triangle_tests and rays when `counters` is non-null.
@@ -87,9 +88,10 @@ class BspTracer final : public Accelerator {
   /// SSE4.2, AVX2, AVX-512 packets (UsageError when the CPU lacks the ISA).
   /// Each lane runs exactly the single-ray steps (lanes that disagree on a
   /// node's near child wait on the stack), so hits and counters equal single
-  /// rays bit for bit. With exact leaves or a box top packets run as single
-  /// rays; with counters, exact leaves or a box top single rays run
-  /// sequentially.
+  /// rays bit for bit. With a box top packets run as single rays; with
+  /// exact leaves each active lane runs the exact test at a leaf. With
+  /// counters or a box top single rays run sequentially, and so do packets
+  /// with exact leaves when counted.
   void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width = 1,
                    RayCounters* counters = nullptr) const override;
   /// The tree cut into subtrees of at most `max_slots` slots, with their

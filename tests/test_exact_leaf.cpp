@@ -1,0 +1,236 @@
+/// \file test_exact_leaf.cpp
+/// The staged exact leaf test (robust/certified_intersector.h) against a
+/// reference written the plain way, in CGAL::Exact_rational: the Plücker signs,
+/// t = n·(v0 - o) / n·d as a rational, its nearest float (robust/nearest_float.h),
+/// a miss beyond the float range, and ties to the lower triangle number. Random
+/// triangles and rays, rays exactly through vertices and edges, coplanar
+/// duplicates, huge and tiny coordinates.
+#include <CGAL/Exact_rational.h>
+
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "geometry/core/triangle_soup.h"
+#include "robust/certified_intersector.h"
+#include "robust/degenerate.h"
+#include "robust/nearest_float.h"
+#include "test_util.h"
+
+namespace bsprt {
+namespace {
+
+using Q = CGAL::Exact_rational;
+using Q3 = std::array<Q, 3>;
+
+Q3 q3(const Vec3f& a) { return {Q(double(a.x)), Q(double(a.y)), Q(double(a.z))}; }
+Q3 qsub(const Q3& a, const Q3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Q qdot(const Q3& a, const Q3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Q3 qcross(const Q3& a, const Q3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+/// The reference decision: the exact t of a hit in [tnear, tfar] (finite as a
+/// float), else nullopt.
+std::optional<Q> reference_t(const Ray& r, const std::array<Vec3f, 3>& tri) {
+  const Q3 o = q3(r.org), d = q3(r.dir), a0 = qsub(q3(tri[0]), o), a1 = qsub(q3(tri[1]), o), a2 = qsub(q3(tri[2]), o);
+  const int s[3] = {CGAL::sign(qdot(qcross(a1, a2), d)), CGAL::sign(qdot(qcross(a2, a0), d)),
+                    CGAL::sign(qdot(qcross(a0, a1), d))};
+  const bool neg = s[0] < 0 || s[1] < 0 || s[2] < 0, pos = s[0] > 0 || s[1] > 0 || s[2] > 0;
+  if ((neg && pos) || !(neg || pos)) return std::nullopt;
+  const Q3 n = qcross(qsub(q3(tri[1]), q3(tri[0])), qsub(q3(tri[2]), q3(tri[0])));
+  const Q t = qdot(n, a0) / qdot(n, d);
+  if (std::isfinite(r.tnear) && t < Q(double(r.tnear))) return std::nullopt;
+  if (std::isfinite(r.tfar) && t > Q(double(r.tfar))) return std::nullopt;
+  if (nearest_float(t) == std::numeric_limits<float>::infinity()) return std::nullopt;
+  return t;
+}
+
+/// The reference nearest hit over `prims`: exact t, ties to the lower number.
+Hit reference_nearest(const TriangleSoup& s, const Ray& r, const std::vector<std::uint32_t>& prims) {
+  std::optional<Q> best;
+  Hit h;
+  for (const std::uint32_t p : prims) {
+    const std::optional<Q> t = reference_t(r, s.corners(p));
+    if (!t) continue;
+    if (!best || *t < *best || (*t == *best && p < h.prim)) best = t, h.prim = p;
+  }
+  if (best) h.t = nearest_float(*best);
+  return h;
+}
+
+TriangleSoup soup_of(const std::vector<std::array<Vec3f, 3>>& tris) {
+  TriangleSoup s;
+  for (const auto& t : tris) {
+    const auto base = std::uint32_t(s.vertices.size());
+    s.vertices.insert(s.vertices.end(), t.begin(), t.end());
+    s.triangles.push_back({base, base + 1, base + 2});
+  }
+  classify_degenerate(s);
+  return s;
+}
+
+Hit staged_nearest(const CertifiedIntersector& c, const Ray& r, const std::vector<std::uint32_t>& prims,
+                   RayCounters* counters = nullptr) {
+  NearestHit best;
+  c.intersect(r, prims, best, counters);
+  return best.hit;
+}
+
+void require_same(const Hit& got, const Hit& want) {
+  REQUIRE(got.prim == want.prim);
+  if (want.hit()) REQUIRE(got.t == want.t);
+}
+
+Ray make_ray(Vec3f o, Vec3f d, float tnear = 0.0f, float tfar = std::numeric_limits<float>::infinity()) {
+  Ray r;
+  r.org = o;
+  r.dir = d;
+  r.tnear = tnear;
+  r.tfar = tfar;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("exact leaf test: random triangles and rays equal the rational reference, no exact stage",
+          "[exact][exact-leaf]") {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  auto p = [&] { return Vec3f{u(rng), u(rng), u(rng)}; };
+  std::vector<std::array<Vec3f, 3>> tris;
+  for (int i = 0; i < 64; ++i) tris.push_back({p(), p(), p()});
+  const TriangleSoup s = soup_of(tris);
+  const CertifiedIntersector c(s);
+  std::vector<std::uint32_t> all;
+  for (std::uint32_t i = 0; i < s.size(); ++i)
+    if (!s.is_degenerate(i)) all.push_back(i);
+  RayCounters counters;
+  int hits = 0;
+  for (int i = 0; i < 2000; ++i) {
+    // Aimed at a random point of a random triangle (most rays hit), or random.
+    const Vec3f o = Vec3f{u(rng), u(rng), u(rng)} * 3.0f;
+    const auto& t = tris[std::size_t(i) % tris.size()];
+    const float a = 0.5f * (u(rng) + 1.0f), b = 0.5f * (u(rng) + 1.0f) * (1.0f - a);
+    const Vec3f target = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+    const Ray r = make_ray(o, i % 4 == 0 ? p() : target - o, i % 3 == 0 ? -1.0f : 0.0f,
+                           i % 5 == 0 ? 1.5f : std::numeric_limits<float>::infinity());
+    const Hit want = reference_nearest(s, r, all);
+    hits += want.hit();
+    require_same(staged_nearest(c, r, all, &counters), want);
+  }
+  CHECK(hits > 500);
+  CHECK(counters.exact_decisions == 0);  // random data never needs more than the filter
+}
+
+TEST_CASE("exact leaf test: rays exactly through vertices and edges of a fan equal the reference",
+          "[exact][exact-leaf]") {
+  // A closed fan around a vertex: six triangles sharing v = (0.3, 0.2, 0.7)
+  // and the edges to its ring, tilted so nothing is axis-aligned.
+  const Vec3f v{0.3f, 0.2f, 0.7f};
+  std::vector<Vec3f> ring;
+  for (int k = 0; k < 6; ++k) {
+    const float a = float(k) * 1.0471976f;
+    ring.push_back({0.3f + std::cos(a), 0.2f + std::sin(a), 0.7f + 0.25f * std::cos(2 * a + 0.5f)});
+  }
+  std::vector<std::array<Vec3f, 3>> tris;
+  for (int k = 0; k < 6; ++k) tris.push_back({v, ring[k], ring[(k + 1) % 6]});
+  const TriangleSoup s = soup_of(tris);
+  const CertifiedIntersector c(s);
+  const std::vector<std::uint32_t> all = {5, 3, 1, 0, 2, 4};  // out of order: ties must still go to 0
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+  RayCounters counters;
+  int through_vertex = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Vec3f o{u(rng), u(rng), 3.0f + u(rng)};
+    // Aim at the shared vertex, at a ring vertex or at an edge's midpoint
+    // (exact in float for these coordinates only sometimes: both kinds occur).
+    Vec3f target = v;
+    if (i % 3 == 1) target = ring[i % 6];
+    if (i % 3 == 2) target = (v + ring[i % 6]) * 0.5f;
+    const Ray r = make_ray(o, target - o);
+    through_vertex += (i % 3 == 0) && (o + (target - o)).x == v.x;
+    require_same(staged_nearest(c, r, all, &counters), reference_nearest(s, r, all));
+  }
+  CHECK(through_vertex > 0);
+  CHECK(counters.rule_decisions > 0);  // exact zeros and ties decided by the rules
+}
+
+TEST_CASE("exact leaf test: coplanar duplicates with reversed winding tie by rule to the lower number",
+          "[exact][exact-leaf]") {
+  std::vector<std::array<Vec3f, 3>> tris;
+  const std::array<Vec3f, 3> t{Vec3f{0, 0, 1}, Vec3f{1, 0.1f, 1.2f}, Vec3f{0.1f, 1, 0.9f}};
+  tris.push_back({t[0], t[2], t[1]});  // 0: reversed copy
+  tris.push_back(t);                   // 1
+  const TriangleSoup s = soup_of(tris);
+  const CertifiedIntersector c(s);
+  const std::vector<std::uint32_t> order = {1, 0};
+  RayCounters counters;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.05f, 0.4f);
+  for (int i = 0; i < 200; ++i) {
+    const Ray r = make_ray({u(rng), u(rng), -1.0f}, {0.01f * u(rng), 0.02f, 1.0f});
+    const Hit want = reference_nearest(s, r, order);
+    REQUIRE(want.prim == 0);
+    require_same(staged_nearest(c, r, order, &counters), want);
+  }
+  CHECK(counters.exact_decisions == 0);
+  CHECK(counters.rule_decisions == 200);
+}
+
+TEST_CASE("exact leaf test: degenerate rays and extreme coordinates equal the reference", "[exact][exact-leaf]") {
+  std::vector<std::array<Vec3f, 3>> tris = {
+      {Vec3f{-1, -1, 1}, Vec3f{3, -1, 1}, Vec3f{-1, 3, 1}},                          // 0: z = 1
+      {Vec3f{-1, -1, 0x1p100f}, Vec3f{3, -1, 0x1p100f}, Vec3f{-1, 3, 0x1p100f}},     // 1: far away
+      {Vec3f{1e-30f, 0, 2}, Vec3f{0, 1e-30f, 2}, Vec3f{-1e-30f, -1e-30f, 2}},        // 2: tiny
+      {Vec3f{0, 0, 3}, Vec3f{1, 0, 3}, Vec3f{0, 0, 4}},                              // 3: in the plane y = 0
+  };
+  const TriangleSoup s = soup_of(tris);
+  const CertifiedIntersector c(s);
+  const std::vector<std::uint32_t> all = {0, 1, 2, 3};
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<Ray> rays = {
+      make_ray({0.25f, 0.25f, 0}, {0, 0, 1e-40f}),          // beyond the float range: a miss
+      make_ray({0.25f, 0.25f, 2}, {0, 0, 0x1p-27f}),        // t near 2^127: finite
+      make_ray({0, 0, 0}, {0, 0, 1}, 1.5f),                  // through the tiny triangle's inside
+      make_ray({1e-30f, 0, 0}, {0, 0, 1}, 1.5f),             // exactly through its vertex
+      make_ray({0.5f, 0, 0}, {0, 0, 1}, 2.5f),               // in the plane of triangle 3: a miss there
+      make_ray({0.25f, 0, 3.5f}, {0, 1, 0}, -inf, inf),      // through triangle 3's inside, whole line
+      make_ray({0, 0, 0}, {0, 0, 1}, 1.0f, 1.0f),            // t = tnear = tfar = 1 on triangle 0
+      make_ray({-1, -1, 0}, {0, 0, 1}),                      // exactly through corners of 0 and 1
+      make_ray({1, 1, 0}, {0, 0, 1}),                        // exactly on the hypotenuse of triangle 0
+  };
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    CAPTURE(i);
+    require_same(staged_nearest(c, rays[i], all), reference_nearest(s, rays[i], all));
+  }
+  CHECK(!staged_nearest(c, rays[0], all).hit());
+  CHECK(staged_nearest(c, rays[1], all).t == 0x1p127f);
+  CHECK(staged_nearest(c, rays[6], all).prim == 0);
+}
+
+TEST_CASE("exact leaf test: ties in t at midpoints of floats round to even, as the reference", "[exact][exact-leaf]") {
+  // t = z / 1 for a ray from the origin along +z to a plane z = c: choose c
+  // as a double midpoint between two floats by making the plane slanted so
+  // that t is exactly (1 + 2^-24) (between 1 and 1 + 2^-23).
+  // Triangle through (0,0,1) with normal (0,0,1) tilted: with o = (0, 0, -2^-24)
+  // and d = (0, 0, 1), t = 1 + 2^-24 exactly, a midpoint: ties to even gives 1.
+  const std::vector<std::array<Vec3f, 3>> tris = {{Vec3f{-1, -1, 1}, Vec3f{3, -1, 1}, Vec3f{-1, 3, 1}}};
+  const TriangleSoup s = soup_of(tris);
+  const CertifiedIntersector c(s);
+  const std::vector<std::uint32_t> all = {0};
+  for (const float z0 : {-0x1p-24f, -0x3p-24f, -0x1p-25f}) {
+    const Ray r = make_ray({0, 0, z0}, {0, 0, 1});
+    CAPTURE(z0);
+    require_same(staged_nearest(c, r, all), reference_nearest(s, r, all));
+  }
+  CHECK(staged_nearest(c, make_ray({0, 0, -0x1p-24f}, {0, 0, 1}), all).t == 1.0f);
+}
+
+}  // namespace bsprt
