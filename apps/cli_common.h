@@ -58,6 +58,7 @@ std::unique_ptr<Accelerator> make_accel(const TraceOptions& o, const TriangleSou
 void register_trace(CLI::App& app);
 void register_render(CLI::App& app);
 void register_info(CLI::App& app);
+void register_inside(CLI::App& app);
 void register_gen_rays(CLI::App& app);
 void register_compare(CLI::App& app);
 void register_build(CLI::App& app);  // build and stats

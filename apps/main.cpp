@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   bsprt::cli::register_trace(app);
   bsprt::cli::register_render(app);
   bsprt::cli::register_info(app);
+  bsprt::cli::register_inside(app);
   bsprt::cli::register_gen_rays(app);
   bsprt::cli::register_compare(app);
   bsprt::cli::register_build(app);

@@ -19,6 +19,11 @@ using Mp = CGAL::Mpzf;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+/// Test hook (CertifiedIntersector::set_filter_off_for_testing): the weights
+/// whose bit is set go to the rules and the exact stage even when the filter
+/// decided them.
+unsigned filter_off_for_testing = 0;
+
 /// Relative bound of the double filter (docs/exact-leaf-test.md, "The double
 /// filter"): every quantity below is a sum of at most six monomials of degree
 /// three in float inputs, computed with at most 8 roundings of 2^-53 each on
@@ -37,8 +42,6 @@ D3 dvec(const Vec3f& a) { return {double(a.x), double(a.y), double(a.z)}; }
 double dot(const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 D3 cross(const D3& a, const D3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 double maxabs(const D3& a) { return std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)}); }
-/// (a x b) . d
-double triple(const D3& a, const D3& b, const D3& d) { return dot(cross(a, b), d); }
 
 /// Whether a - b (floats) is exact in double: Knuth's two-sum error is zero.
 bool exact_difference(float a, float b) {
@@ -127,6 +130,7 @@ struct Candidate {
   float t, u, v;
   std::uint8_t on = 0;  ///< NearestHit::on
   Vec3f p, q;
+  int sign = 0;  ///< the weights' common sign: +1 or -1 (which side the ray comes from)
 };
 
 /// Decision counts of one call, added to the counters once.
@@ -134,25 +138,89 @@ struct Stages {
   std::uint64_t rule = 0, exact = 0;
 };
 
+/// Per-ray constants of the double filter: the watertight test's shear
+/// (Woop, Benthin and Wald, JCGT 2013) in double. kz is the axis of the
+/// largest |d|, and (kx, ky, kz) is cyclic, or swapped when d[kz] < 0, so the
+/// sheared 2D cross products have the signs of the Plücker volumes
+/// (docs/exact-leaf-test.md, "The double filter").
+struct FilterRay {
+  D3 d;
+  double abs_d;  ///< |d[kz]|: sheared volumes are the Plücker ones divided by it
+  int kx, ky, kz;
+  double sx, sy, asx, asy;  ///< d[kx] / d[kz], d[ky] / d[kz] and their magnitudes
+};
+double at(const D3& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+FilterRay filter_ray(const Ray& ray) {
+  FilterRay f;
+  f.d = dvec(ray.dir);
+  const double ax = std::abs(f.d.x), ay = std::abs(f.d.y), az = std::abs(f.d.z);
+  f.kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+  f.kx = f.kz == 2 ? 0 : f.kz + 1;
+  f.ky = f.kx == 2 ? 0 : f.kx + 1;
+  if (at(f.d, f.kz) < 0) std::swap(f.kx, f.ky);
+  const double dz = at(f.d, f.kz);
+  f.abs_d = std::abs(dz);
+  f.sx = at(f.d, f.kx) / dz;
+  f.sy = at(f.d, f.ky) / dz;
+  f.asx = std::abs(f.sx);
+  f.asy = std::abs(f.sy);
+  return f;
+}
+
 /// Decides one triangle; nullopt = no hit with t in [tnear, tfar].
-std::optional<Candidate> test_one(const Ray& ray, const std::array<Vec3f, 3>& tri, Stages& st) {
-  // Double stage: the weights of v0, v1, v2 and their static error bounds.
-  const D3 d = dvec(ray.dir);
+/// Simulation of simplicity for a weight that is exactly 0: its sign when the
+/// origin moves to o + (e, e^2, e^3) for an infinitesimal e > 0. The weight
+/// pairing p and q (in this order) becomes w - delta.((q - p) x d), so its sign
+/// is minus the sign of the first non-zero component of (q - p) x d; 0 when q - p
+/// is parallel to d (the ray is then parallel to the triangle's plane).
+int sos_sign(const Vec3f& p, const Vec3f& q, const Vec3f& dir) {
+  const M3 c = mcross(msub(q, p), mvec(dir));
+  for (const Mp* x : {&c.x, &c.y, &c.z})
+    if (const int s = msign(*x); s != 0) return -s;
+  return 0;
+}
+
+/// Decides one triangle; nullopt = no hit with t in [tnear, tfar]. With
+/// `sos`, a crossing of the perturbed ray instead (sos_sign): exact zeros
+/// take their perturbed signs, so a ray through a shared edge or vertex of a
+/// closed, consistently oriented mesh crosses exactly one triangle of each sheet.
+std::optional<Candidate> test_one(const Ray& ray, const FilterRay& fr, const std::array<Vec3f, 3>& tri, Stages& st,
+                                  bool sos = false) {
+  // Double stage: the sheared vertices, then the weights of v0, v1, v2 as 2D
+  // cross products, each with the static bound 2^-47 * Mx * My, where Mx and
+  // My bound |a[kx]| + |sx| |a[kz]| and |a[ky]| + |sy| |a[kz]| over the corners.
   const D3 a0 = dsub(tri[0], ray.org), a1 = dsub(tri[1], ray.org), a2 = dsub(tri[2], ray.org);
-  const double m0 = maxabs(a0), m1 = maxabs(a1), m2 = maxabs(a2), md = maxabs(d);
-  double w[3] = {triple(a1, a2, d), triple(a2, a0, d), triple(a0, a1, d)};
-  int s[3] = {filtered_sign(w[0], 6 * kRel * (m1 * m2 * md)), filtered_sign(w[1], 6 * kRel * (m2 * m0 * md)),
-              filtered_sign(w[2], 6 * kRel * (m0 * m1 * md))};
-  for (int i = 0; i < 3; ++i)
-    for (int j = i + 1; j < 3; ++j)
-      if (opposite(s[i], s[j])) return std::nullopt;
+  const double c0[3] = {a0.x, a0.y, a0.z}, c1[3] = {a1.x, a1.y, a1.z}, c2[3] = {a2.x, a2.y, a2.z};
+  const double z0 = c0[fr.kz], z1 = c1[fr.kz], z2 = c2[fr.kz];
+  const double x0 = c0[fr.kx] - fr.sx * z0, y0 = c0[fr.ky] - fr.sy * z0;
+  const double x1 = c1[fr.kx] - fr.sx * z1, y1 = c1[fr.ky] - fr.sy * z1;
+  const double x2 = c2[fr.kx] - fr.sx * z2, y2 = c2[fr.ky] - fr.sy * z2;
+  const double az = std::max(std::max(std::abs(z0), std::abs(z1)), std::abs(z2));
+  const double ax = std::max(std::max(std::abs(c0[fr.kx]), std::abs(c1[fr.kx])), std::abs(c2[fr.kx]));
+  const double ay = std::max(std::max(std::abs(c0[fr.ky]), std::abs(c1[fr.ky])), std::abs(c2[fr.ky]));
+  const double mx = ax + fr.asx * az, my = ay + fr.asy * az;  // bounds of |a[kx]| + |sx| |a[kz]|, ...
+  const double bound = 0x1p-47 * (mx * my);
+  double w[3];
+  int s[3];
+  w[0] = x1 * y2 - y1 * x2;
+  w[1] = x2 * y0 - y2 * x0;
+  s[0] = filtered_sign(w[0], bound);
+  s[1] = filtered_sign(w[1], bound);
+  if (opposite(s[0], s[1])) return std::nullopt;  // a miss whatever the third weight is
+  w[2] = x0 * y1 - y0 * x1;
+  s[2] = filtered_sign(w[2], bound);
+  if (opposite(s[0], s[2]) || opposite(s[1], s[2])) return std::nullopt;
+  if (filter_off_for_testing != 0) {
+    for (int k = 0; k < 3; ++k)
+      if ((filter_off_for_testing >> k) & 1u) s[k] = 2;
+  }
   if (s[0] == 2 || s[1] == 2 || s[2] == 2) {
     // A vertex exactly on the ray's line through o + d: the two weights that
     // pair it with d are triple products with a repeated vector, exactly 0.
     const D3* a[3] = {&a0, &a1, &a2};
     bool rule = false;
     for (int i = 0; i < 3; ++i) {
-      if (!exactly_on_direction(tri[i], ray.org, *a[i], d)) continue;
+      if (!exactly_on_direction(tri[i], ray.org, *a[i], fr.d)) continue;
       for (int k = 0; k < 3; ++k)
         if (k != i && s[k] == 2) s[k] = 0, w[k] = 0.0, rule = true;
     }
@@ -162,17 +230,24 @@ std::optional<Candidate> test_one(const Ray& ray, const std::array<Vec3f, 3>& tr
       const M3* e[3] = {&e0, &e1, &e2};
       for (int k = 0; k < 3; ++k) {
         if (s[k] != 2) continue;
-        const Mp x = mdot(mcross(*e[(k + 1) % 3], *e[(k + 2) % 3]), ed);
+        const Mp x = mdot(mcross(*e[(k + 1) % 3], *e[(k + 2) % 3]), ed);  // the Plücker volume
         s[k] = msign(x);
-        w[k] = s[k] == 0 ? 0.0 : x.to_double();
+        w[k] = s[k] == 0 ? 0.0 : x.to_double() / fr.abs_d;  // on the sheared scale, for u and v
       }
     } else if (rule) {
       ++st.rule;
     }
   }
+  if (sos && (s[0] == 0 || s[1] == 0 || s[2] == 0)) {
+    if (s[0] == 0 && s[1] == 0 && s[2] == 0) return std::nullopt;  // the ray lies in the plane
+    ++st.exact;
+    for (int k = 0; k < 3; ++k)
+      if (s[k] == 0) s[k] = sos_sign(tri[(k + 1) % 3], tri[(k + 2) % 3], ray.dir);
+  }
   if (!meets(s[0], s[1], s[2])) return std::nullopt;
 
   Candidate c;
+  c.sign = (s[0] > 0 || s[1] > 0 || s[2] > 0) ? 1 : -1;
   const int zeros = int(s[0] == 0) + int(s[1] == 0) + int(s[2] == 0);
   if (zeros == 2) {
     c.on = 1;
@@ -191,8 +266,8 @@ std::optional<Candidate> test_one(const Ray& ray, const std::array<Vec3f, 3>& tr
   const D3 f1 = dsub(tri[1], tri[0]), f2 = dsub(tri[2], tri[0]);
   const D3 n = cross(f1, f2);
   const double mn = 2 * maxabs(f1) * maxabs(f2);
-  double num = dot(n, a0), den = dot(n, d);
-  const double enum_ = 3 * kRel * (mn * m0), eden = 3 * kRel * (mn * md);
+  double num = dot(n, a0), den = dot(n, fr.d);
+  const double enum_ = 3 * kRel * (mn * maxabs(a0)), eden = 3 * kRel * (mn * maxabs(fr.d));
   const double tnear = ray.tnear, tfar = ray.tfar;
   bool decided = false;
   if (std::abs(den) > eden) {
@@ -247,9 +322,12 @@ bool same_t_by_rule(const Candidate& c, const std::array<Vec3f, 3>& tri, const N
 
 CertifiedIntersector::CertifiedIntersector(const TriangleSoup& soup) : soup_(soup) {}
 
+void CertifiedIntersector::set_filter_off_for_testing(unsigned weights) { filter_off_for_testing = weights & 7u; }
+
 void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32_t> prims,
                                      const LeafTriangle* corners, NearestHit& best, RayCounters* counters) const {
   if (!is_valid(ray)) return;
+  const FilterRay fr = filter_ray(ray);
   Stages st;
   for (std::size_t i = 0; i < prims.size(); ++i) {
     const std::uint32_t prim = prims[i];
@@ -261,7 +339,7 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     if (best.hit.hit() && prim == best.hit.prim) continue;
     const std::array<Vec3f, 3> tri =
         corners ? std::array<Vec3f, 3>{corners[i].v[0], corners[i].v[1], corners[i].v[2]} : soup_.corners(prim);
-    const std::optional<Candidate> c = test_one(ray, tri, st);
+    const std::optional<Candidate> c = test_one(ray, fr, tri, st);
     if (!c) continue;
     bool nearer;
     if (!best.hit.hit() || c->t_hi < best.t_lo) {
@@ -288,6 +366,25 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     best.on = c->on;
     best.p = c->p;
     best.q = c->q;
+  }
+  if (st.exact) fallbacks_.fetch_add(st.exact, std::memory_order_relaxed);
+  if (counters) {
+    counters->rule_decisions += st.rule;
+    counters->exact_decisions += st.exact;
+  }
+}
+
+void CertifiedIntersector::crossings(const Ray& ray, std::span<const std::uint32_t> prims, std::vector<Crossing>& out,
+                                     RayCounters* counters) const {
+  if (!is_valid(ray)) return;
+  const FilterRay fr = filter_ray(ray);
+  Stages st;
+  for (const std::uint32_t prim : prims) {
+    if (counters) ++counters->triangle_tests;
+    const std::array<Vec3f, 3> tri = soup_.corners(prim);
+    const std::optional<Candidate> c = test_one(ray, fr, tri, st, true);
+    if (!c) continue;
+    out.push_back({prim, c->t, c->sign});
   }
   if (st.exact) fallbacks_.fetch_add(st.exact, std::memory_order_relaxed);
   if (counters) {

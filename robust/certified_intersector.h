@@ -23,6 +23,8 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
+#include <vector>
 
 #include "geometry/core/triangle_soup.h"
 #include "traverse/leaf_intersector.h"
@@ -39,9 +41,31 @@ class CertifiedIntersector final : public LeafIntersector {
   void intersect(const Ray& ray, std::span<const std::uint32_t> prims, const LeafTriangle* corners,
                  NearestHit& best, RayCounters* counters) const override;
 
+  /// A crossing of a ray with a triangle (crossings()).
+  struct Crossing {
+    std::uint32_t prim;  ///< triangle number
+    float t;             ///< the exact t rounded to float
+    int side;            ///< +1 or -1: the sign of n·d with n = (v1 - v0) x (v2 - v0)
+  };
+  /// Appends every triangle of `prims` that the ray crosses with t in
+  /// [tnear, tfar], exactly, with simulation of simplicity for exact zeros (the
+  /// origin moved to o + (e, e^2, e^3)): a ray through a shared edge or vertex
+  /// of a closed, consistently oriented mesh crosses exactly one triangle of
+  /// each sheet it passes through, and one that only touches a sheet crosses it
+  /// zero or two times. A ray in a triangle's plane does not cross it. Corners
+  /// are read from the scene. Counts as intersect() does.
+  void crossings(const Ray& ray, std::span<const std::uint32_t> prims, std::vector<Crossing>& out,
+                 RayCounters* counters) const;
+
   /// Decisions the filter and the rules could not make, done in exact
   /// arithmetic (all threads; one shared counter, added once per call).
   std::uint64_t exact_fallbacks() const { return fallbacks_.load(std::memory_order_relaxed); }
+
+  /// Tests only, single-threaded: the weights (bit k: the weight of v_k)
+  /// whose signs the double filter decided are decided again by the rules and
+  /// the exact stage (a miss from two opposite filtered signs stays a miss), so
+  /// tests can check that filtered and exact signs mix correctly. 0 = off. Global.
+  static void set_filter_off_for_testing(unsigned weights);
 
  private:
   const TriangleSoup& soup_;

@@ -133,24 +133,37 @@ std::size_t ExactTracer::memory_bytes() const {
          impl_->tree.size() * 2 * sizeof(CGAL::Bbox_3);
 }
 
+void ExactTracer::touched(const Ray& ray, std::vector<std::uint32_t>& prims) const {
+  prims.clear();
+  if (!is_valid(ray) || impl_->triangles.empty()) return;
+  // Candidates from the AABB tree (exact predicates): a ray when the segment
+  // starts at or after the origin, else the whole line. When no exact Epick
+  // query exists (exact_candidate_direction), every triangle is a candidate:
+  // the exact tests decide, only slower.
+  std::vector<TriangleList::const_iterator> hits;
+  const Epick::Point_3 eo = to_epick(ray.org);
+  if (const std::optional<Epick::Vector_3> ed = exact_candidate_direction(ray)) {
+    if (ray.tnear >= 0.0f)
+      impl_->tree.all_intersected_primitives(Epick::Ray_3(eo, *ed), std::back_inserter(hits));
+    else
+      impl_->tree.all_intersected_primitives(Epick::Line_3(eo, *ed), std::back_inserter(hits));
+    for (const auto& it : hits) prims.push_back(impl_->prim[std::size_t(it - impl_->triangles.cbegin())]);
+  } else {
+    prims = impl_->prim;
+  }
+}
+
+bool ExactTracer::on_surface(const Vec3f& p) const {
+  if (impl_->triangles.empty() || !is_finite(p)) return false;
+  return impl_->tree.do_intersect(to_epick(p));
+}
+
 Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
   if (counters) ++counters->rays;
   Hit best;
   if (!is_valid(ray) || impl_->triangles.empty()) return best;
-  // Candidates from the AABB tree (exact predicates): a ray when the segment
-  // starts at or after the origin, else the whole line. When no exact Epick
-  // query exists (exact_candidate_direction), every triangle is a candidate:
-  // the exact tests below decide, only slower.
-  std::vector<TriangleList::const_iterator> candidates;
-  const Epick::Point_3 eo = to_epick(ray.org);
-  if (const std::optional<Epick::Vector_3> ed = exact_candidate_direction(ray)) {
-    if (ray.tnear >= 0.0f)
-      impl_->tree.all_intersected_primitives(Epick::Ray_3(eo, *ed), std::back_inserter(candidates));
-    else
-      impl_->tree.all_intersected_primitives(Epick::Line_3(eo, *ed), std::back_inserter(candidates));
-  } else {
-    for (auto it = impl_->triangles.cbegin(); it != impl_->triangles.cend(); ++it) candidates.push_back(it);
-  }
+  std::vector<std::uint32_t> candidates;
+  touched(ray, candidates);
   if (candidates.empty()) return best;
 
   const Epeck::Point_3 o = to_epeck(ray.org);
@@ -162,9 +175,7 @@ Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
   std::optional<FT> best_t;
   std::optional<Epeck::Point_3> best_p;
   std::uint32_t best_prim = kNoHit;
-  for (const auto& it : candidates) {
-    const std::size_t i = std::size_t(it - impl_->triangles.begin());
-    const std::uint32_t t = impl_->prim[i];
+  for (const std::uint32_t t : candidates) {
     if (counters) ++counters->triangle_tests;
     const auto [a, b, c] = impl_->soup.corners(t);
     const Epeck::Triangle_3 tri(to_epeck(a), to_epeck(b), to_epeck(c));

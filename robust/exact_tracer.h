@@ -8,7 +8,9 @@
 /// rounded to float. Slow compared with the float tracers: a reference, used by
 /// tests, `bsprt bench` and `bsprt compare`.
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "geometry/core/triangle_soup.h"
 #include "traverse/accelerator.h"
@@ -26,6 +28,13 @@ class ExactTracer final : public Accelerator {
   std::string name() const override { return "exact"; }
   Hit trace(const Ray& ray, RayCounters* counters = nullptr) const override;
   std::size_t memory_bytes() const override;
+  /// The non-degenerate triangles whose closed triangle the ray touches, by
+  /// the AABB tree's exact predicates (tnear >= 0: the ray from the origin, else
+  /// the whole line; every triangle when no exact query exists). A superset of
+  /// the triangles hit with t in [tnear, tfar].
+  void touched(const Ray& ray, std::vector<std::uint32_t>& prims) const;
+  /// Whether p lies on a non-degenerate triangle (closed), exactly.
+  bool on_surface(const Vec3f& p) const;
 
  private:
   struct Impl;

@@ -128,6 +128,44 @@ TEST_CASE("exact leaf test: random triangles and rays equal the rational referen
   CHECK(counters.exact_decisions == 0);  // random data never needs more than the filter
 }
 
+TEST_CASE("exact leaf test: signs from the filter and from the exact stage mix correctly", "[exact][exact-leaf]") {
+  // The filter works on the sheared ray (its 2D cross products have the
+  // Plücker volumes' signs); the exact stage on the Plücker volumes. Forcing
+  // some weights through the exact stage mixes the two on one triangle.
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  auto p = [&] { return Vec3f{u(rng), u(rng), u(rng)}; };
+  std::vector<std::array<Vec3f, 3>> tris;
+  for (int i = 0; i < 16; ++i) tris.push_back({p(), p(), p()});
+  const TriangleSoup s = soup_of(tris);
+  const CertifiedIntersector c(s);
+  std::vector<std::uint32_t> all;
+  for (std::uint32_t i = 0; i < s.size(); ++i)
+    if (!s.is_degenerate(i)) all.push_back(i);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 600; ++i) {
+    const auto& t = tris[std::size_t(i) % tris.size()];
+    const Vec3f o = p() * 3.0f, target = (t[0] + t[1] + t[2]) * (1.0f / 3.0f) + p() * 0.2f;
+    Vec3f d = target - o;
+    if (i % 2) d = Vec3f{-d.x, d.y, -d.z};  // every sign of the dominant axis
+    rays.push_back(make_ray(o, d, -10.0f));
+  }
+  for (const unsigned weights : {1u, 2u, 4u, 5u, 6u, 7u}) {
+    CAPTURE(weights);
+    CertifiedIntersector::set_filter_off_for_testing(weights);
+    RayCounters counters;
+    int hits = 0;
+    for (const Ray& r : rays) {
+      const Hit want = reference_nearest(s, r, all);
+      hits += want.hit();
+      require_same(staged_nearest(c, r, all, &counters), want);
+    }
+    CertifiedIntersector::set_filter_off_for_testing(0);
+    CHECK(hits > 100);
+    CHECK(counters.exact_decisions > 0);
+  }
+}
+
 TEST_CASE("exact leaf test: rays exactly through vertices and edges of a fan equal the reference",
           "[exact][exact-leaf]") {
   // A closed fan around a vertex: six triangles sharing v = (0.3, 0.2, 0.7)

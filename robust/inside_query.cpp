@@ -1,0 +1,48 @@
+#include "robust/inside_query.h"
+
+#include <algorithm>
+#include <map>
+#include <utility>
+#include <vector>
+
+namespace bsprt {
+
+std::string point_side_name(PointSide s) {
+  return s == PointSide::Inside ? "inside" : (s == PointSide::Outside ? "outside" : "surface");
+}
+
+std::size_t open_or_inconsistent_edges(const TriangleSoup& soup) {
+  // Per undirected edge: uses in each direction (lower vertex first = forward).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<int, int>> uses;
+  for (std::uint32_t t = 0; t < soup.size(); ++t) {
+    if (soup.is_degenerate(t)) continue;
+    const auto& tri = soup.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      auto& u = uses[{std::min(a, b), std::max(a, b)}];
+      (a < b ? u.first : u.second) += 1;
+    }
+  }
+  std::size_t bad = 0;
+  for (const auto& [edge, u] : uses) bad += !(u.first == 1 && u.second == 1);
+  return bad;
+}
+
+InsideQuery::InsideQuery(const TriangleSoup& soup) : exact_(soup), cert_(soup) {}
+
+PointSide InsideQuery::side(const Vec3f& p, RayCounters* counters) const {
+  if (!is_finite(p)) return PointSide::Outside;
+  if (exact_.on_surface(p)) return PointSide::OnSurface;
+  Ray r;
+  r.org = p;
+  r.dir = ray_direction();
+  r.tnear = 0.0f;
+  std::vector<std::uint32_t> candidates;
+  exact_.touched(r, candidates);
+  std::vector<CertifiedIntersector::Crossing> crossings;
+  cert_.crossings(r, candidates, crossings, counters);
+  if (counters) ++counters->rays;
+  return crossings.size() % 2 == 1 ? PointSide::Inside : PointSide::Outside;
+}
+
+}  // namespace bsprt
