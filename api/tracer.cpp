@@ -25,8 +25,9 @@ namespace {
 std::string accel_for(TreeKind kind, std::string_view mode) {
   const std::string m(mode);
   if (kind == TreeKind::Kd) {
-    if (m == "float" || m == "kd") return "kd";
-    throw UsageError("mode '" + m + "' is not a kd-tree mode (kd-trees trace in mode 'float')");
+    if (m == "certified" || m == "kd") return "kd";
+    if (m == "float" || m == "kd-float") return "kd-float";
+    throw UsageError("mode '" + m + "' is not a kd-tree mode (certified or float)");
   }
   if (m == "certified") return "bsp";
   if (m == "float") return "bsp-float";

@@ -100,11 +100,11 @@ std::string bench_speed_summary(const BenchResult& res, const std::string& ray_s
   std::vector<std::string> bsp_modes, counted;  // BSP modes (ratios), modes with triangle counters
   for (const std::string& m : modes) {
     if (accel_info(m).tree == AccelTree::Bsp && accel_info(m).packets) bsp_modes.push_back(m);
-    if (m == "kd" || (accel_info(m).tree == AccelTree::Bsp && accel_info(m).packets)) counted.push_back(m);
+    if (accel_info(m).tree != AccelTree::None && accel_info(m).packets) counted.push_back(m);
   }
   // What exactness costs: the default (exact leaves) against the float leaf test.
-  const bool has_float = std::find(modes.begin(), modes.end(), "bsp-float") != modes.end() &&
-                         std::find(modes.begin(), modes.end(), "bsp") != modes.end();
+  const auto has = [&](const char* m) { return std::find(modes.begin(), modes.end(), m) != modes.end(); };
+  const bool has_float = has("bsp-float") && has("bsp"), has_kd_float = has("kd-float") && has("kd");
   const bool has_kd = std::find(modes.begin(), modes.end(), "kd") != modes.end();
   const bool has_embree = std::find(modes.begin(), modes.end(), "embree") != modes.end();
   std::string head = "| scene | triangles |", rule = "|---|---:|";
@@ -117,6 +117,7 @@ std::string bench_speed_summary(const BenchResult& res, const std::string& ray_s
   if (packets && has_kd) head += " bsp packets / kd packets |", rule += "---:|";
   if (packets && has_embree) head += " bsp packets / embree packets |", rule += "---:|";
   if (has_float) head += " bsp time / bsp-float time | packets |", rule += "---:|---:|";
+  if (has_kd_float) head += " kd time / kd-float time | packets |", rule += "---:|---:|";
   std::string tests_head;
   for (const std::string& m : counted) tests_head += (tests_head.empty() ? "" : " → ") + m;
   if (!counted.empty()) head += " tri tests/ray " + tests_head + " |", rule += "---:|";
@@ -141,6 +142,7 @@ std::string bench_speed_summary(const BenchResult& res, const std::string& ray_s
     if (packets && has_kd) body += ratio("bsp", "kd", true);
     if (packets && has_embree) body += ratio("bsp", "embree", true);
     if (has_float) body += ratio("bsp-float", "bsp", false) + ratio("bsp-float", "bsp", true);
+    if (has_kd_float) body += ratio("kd-float", "kd", false) + ratio("kd-float", "kd", true);
     if (!counted.empty()) {
       std::string tests;
       for (const std::string& m : counted) {

@@ -21,7 +21,7 @@ namespace {
 struct BenchArgs {
   std::vector<std::string> scenes;
   std::vector<std::string> rays = {"primary", "random", "vertex", "edge"};
-  std::vector<std::string> modes = {"kd", "bsp", "bsp-float", "bsp-zero-eps", "embree", "embree-fast"};
+  std::vector<std::string> modes = {"kd", "kd-float", "bsp", "bsp-float", "bsp-zero-eps", "embree", "embree-fast"};
   std::size_t count = 262144;
   std::size_t error_count = 20000;
   int threads = 0;

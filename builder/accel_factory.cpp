@@ -38,12 +38,33 @@ std::shared_ptr<const TreeFileReader> tree_file_of(const AccelOptions& options) 
   return nullptr;
 }
 
-std::unique_ptr<Accelerator> make_kd(const TriangleSoup& soup, const AccelOptions& options) {
+KdTree load_or_build_kd(const TriangleSoup& soup, const AccelOptions& options) {
   const auto file = tree_file_of(options);
-  KdTree tree = file ? read_kd_tree(*file, soup)
-                     : with_threads(options.threads, [&] { return build_kd(soup); });
-  return std::make_unique<KdTracer>(std::move(tree), soup);
+  return file ? read_kd_tree(*file, soup) : with_threads(options.threads, [&] { return build_kd(soup); });
 }
+
+std::unique_ptr<Accelerator> make_kd_float(const TriangleSoup& soup, const AccelOptions& options) {
+  return std::make_unique<KdTracer>(load_or_build_kd(soup, options), soup);
+}
+
+/// A kd tracer whose leaves use the exact-decision test (owns that test).
+class CertifiedKdTracer final : public Accelerator {
+ public:
+  CertifiedKdTracer(KdTree tree, const TriangleSoup& soup) : exact_(soup), kd_(std::move(tree), soup) {
+    kd_.set_exact_leaf(&exact_);
+  }
+  std::string name() const override { return kd_.name(); }
+  Hit trace(const Ray& ray, RayCounters* counters) const override { return kd_.trace(ray, counters); }
+  void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
+                   RayCounters* counters) const override {
+    kd_.trace_batch(rays, hits, packet_width, counters);
+  }
+  std::size_t memory_bytes() const override { return kd_.memory_bytes(); }
+
+ private:
+  CertifiedIntersector exact_;
+  KdTracer kd_;
+};
 
 /// A BSP tracer whose leaves use the exact-decision test (owns that test).
 class CertifiedBspTracer final : public Accelerator {
@@ -126,7 +147,13 @@ constexpr AccelInfo kTable[] = {
      [](const TriangleSoup& s, const AccelOptions&) { return make_embree(s, true); }},
     {"embree-fast", "Embree 3, default mode", A::None, false, true, false, true, false, false,
      [](const TriangleSoup& s, const AccelOptions&) { return make_embree(s, false); }},
-    {"kd", "SAH kd-tree, float watertight leaf test", A::Kd, false, true, false, false, false, false, make_kd},
+    {"kd", "SAH kd-tree, conservative traversal, exact-decision leaf test (the default)", A::Kd, true, true, false,
+     false, false, false,
+     [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
+       return std::make_unique<CertifiedKdTracer>(load_or_build_kd(s, o), s);
+     }},
+    {"kd-float", "SAH kd-tree, float watertight leaf test", A::Kd, false, true, false, false, false, false,
+     make_kd_float},
     {"bsp", "exact BSP, certified traversal, exact-decision leaf test (the default)", A::Bsp, true, true, false,
      false, true, false,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {

@@ -179,10 +179,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Box tops of one-slot subtrees: every leaf under its own box, the deepest top.
   expect_agree("bsp-top vs exact", exact, trace(*make("bsp-top", soup, 1), rays));
   expect_agree("bsp-top-float vs brute", brute, trace(*make("bsp-top-float", soup, 1), rays));
-  const auto kd = make("kd", soup), bsp = make("bsp-float", soup);
-  expect_agree("kd vs brute", brute, trace(*kd, rays));
+  expect_agree("kd vs exact", exact, trace(*make("kd", soup), rays));
+  expect_packets_equal("kd", *make("kd", soup), rays);  // exact leaves in the packet kernels
+  const auto kd = make("kd-float", soup), bsp = make("bsp-float", soup);
+  expect_agree("kd-float vs brute", brute, trace(*kd, rays));
   expect_agree("bsp-float vs brute", brute, trace(*bsp, rays));
-  expect_packets_equal("kd", *kd, rays);
+  expect_packets_equal("kd-float", *kd, rays);
   expect_packets_equal("bsp-float", *bsp, rays);
   expect_interleaved_equal(*bsp, rays);
   expect_packets_equal("bsp", *make("bsp", soup), rays);  // exact leaves in the packet kernels

@@ -84,6 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
   }
   try_accel("kd", path);
+  try_accel("kd-float", path);
   try_accel("bsp", path);
   try_accel("bsp-float", path);
   try_accel("bsp-top", path);

@@ -24,13 +24,14 @@ namespace bsprt::test {
 
 /// Every tracer of one scene, made from the accelerator table; `soup` must outlive it.
 struct ModeSet {
-  /// kd, bsp (exact leaves), bsp-float, bsp-top and bsp-top-float (box tops over
+  /// kd-float, kd and bsp (exact leaves), bsp-float, bsp-top and bsp-top-float (box tops over
   /// 8-slot subtrees: many boxes even on small scenes) (+ embree when asked);
   /// the BSP modes share one build, handed to them as an in-memory tree file.
   std::vector<std::unique_ptr<Accelerator>> modes;
   std::unique_ptr<Accelerator> exact;
 
   ModeSet(const TriangleSoup& soup, bool with_embree, bool with_exact = true) {
+    modes.push_back(make_tracer("kd-float", soup));
     modes.push_back(make_tracer("kd", soup));
     BspConfig config;
     config.threads = 1;

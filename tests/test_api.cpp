@@ -126,7 +126,7 @@ TEST_CASE("api: trees built or saved or loaded trace what the CLI traces", "[api
     const Tree loaded = Tree::load(cli.tree, scene);
     CHECK(loaded.kind() == (accel == std::string("bsp") ? TreeKind::Bsp : TreeKind::Kd));
     std::vector<Hit> hits(rays.size());
-    Tracer(scene, loaded, accel == std::string("bsp") ? "certified" : "float").intersect(rays, hits);
+    Tracer(scene, loaded, "certified").intersect(rays, hits);  // bsp or kd: exact leaves
     CHECK(same_hits(hits, expected));
     // A tree the API builds: saved, it is a tree file the CLI traces to the same hits.
     BuildOptions o;
@@ -140,7 +140,7 @@ TEST_CASE("api: trees built or saved or loaded trace what the CLI traces", "[api
                 .status == 0);
     CHECK(same_hits(read_hits(again), expected));
     std::vector<Hit> mine(rays.size());
-    Tracer(scene, built, accel == std::string("bsp") ? "certified" : "float").intersect(rays, mine);
+    Tracer(scene, built, "certified").intersect(rays, mine);
     CHECK(same_hits(mine, expected));
   }
 }
@@ -260,7 +260,10 @@ TEST_CASE("api: every mode at every packet width and thread count gives the CLI'
   CHECK_THROWS_AS(Tracer(scene, bsp, "no-such-mode"), UsageError);
   BuildOptions kd;
   kd.kind = TreeKind::Kd;
-  CHECK_THROWS_AS(Tracer(scene, build(scene, kd), "certified"), UsageError);
+  const Tree kd_tree = build(scene, kd);
+  CHECK(Tracer(scene, kd_tree, "certified").name() == "kd");  // exact leaves on kd-trees too
+  CHECK(Tracer(scene, kd_tree, "float").name() == "kd-float");
+  CHECK_THROWS_AS(Tracer(scene, kd_tree, "top"), UsageError);
   CHECK_THROWS_AS(Tracer::by_name(scene, "no-such-accel"), UsageError);
   const std::vector<std::string> names = Tracer::accelerators();
   CHECK(std::find(names.begin(), names.end(), "embree") != names.end());

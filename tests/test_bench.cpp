@@ -98,7 +98,7 @@ TEST_CASE("bench: exact against itself has zero error; certified modes lose noth
     CHECK(e.error.tie == 0);
     CHECK(e.error.max_t_ulps == 0.0);
     CHECK(e.median_t_ulps == 0.0);
-    for (const std::string mode : {"bsp", "brute-certified"}) {
+    for (const std::string mode : {"bsp", "kd", "brute-certified"}) {
       INFO(mode);
       CHECK(row(set, mode).error.agrees());  // the default: nothing lost, extra, farther or nearer
       CHECK(row(set, mode).error.tie == 0);   // and the same tie rule: the same triangle

@@ -136,7 +136,7 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
     return read_hits(hits);
   };
   const auto exact = trace("exact", ""), certified = trace("bsp", "--tree " + tree);
-  const auto brute = trace("brute", ""), bsp = trace("bsp-float", "--tree " + tree), kd_hits = trace("kd", "--tree " + kd);
+  const auto brute = trace("brute", ""), bsp = trace("bsp-float", "--tree " + tree), kd_hits = trace("kd-float", "--tree " + kd);
   // The default BSP (exact leaves) equals the exact reference ray by ray.
   const HitComparison c = compare_hits(exact, certified);
   CHECK(c.agrees());

@@ -320,8 +320,9 @@ TEST_CASE("kd tree files: round trip, corrupt, truncated, wrong scene", "[kd][fi
 
   AccelOptions opt;
   opt.tree_path = path;
-  const auto from_file = make_tracer("kd", s, opt);
-  CHECK(from_file->name() == "kd");
+  CHECK(make_tracer("kd", s, opt)->name() == "kd");  // exact leaves, from the same file
+  const auto from_file = make_tracer("kd-float", s, opt);
+  CHECK(from_file->name() == "kd-float");
   const std::vector<Ray> rays = random_rays(s, 500, 9);
   CHECK(compare_hits(brute_hits(s, rays), kd_hits(static_cast<const KdTracer&>(*from_file), rays), "file") == 0);
 

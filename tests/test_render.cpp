@@ -86,7 +86,7 @@ TEST_CASE("path tracing: brute force and Embree give the same image up to ties",
 
 TEST_CASE("path tracing: kd-tree and BSP give the same image up to ties", "[render]") {
   const TriangleSoup scene = make_default_scene();
-  const auto kd = make_tracer("kd", scene);
+  const auto kd = make_tracer("kd-float", scene);
   const auto bsp = make_tracer("bsp-float", scene);
   const Image a = render_path(*kd, scene, small_path());
   const Image b = render_path(*bsp, scene, small_path());

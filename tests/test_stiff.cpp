@@ -46,7 +46,7 @@ void check_kind(const StiffScene& sc, const ModeSet& m, std::optional<StiffRayKi
                  << ", farther " << c.farther << ", nearer " << c.nearer << ", ties " << c.tie
                  << ", first bad ray " << c.first_bad_ray);
     row += fmt::format(" {}/{}/{}/{} {:.0f} |", c.lost, c.extra, c.farther, c.nearer, c.max_t_ulps);
-    if (t->name() == "bsp" || t->name() == "bsp-top" || t->name() == "brute-certified")
+    if (t->name() == "kd" || t->name() == "bsp" || t->name() == "bsp-top" || t->name() == "brute-certified")
       CHECK(c.agrees());
     if (kind == StiffRayKind::Invalid) CHECK(c.both_miss == rays.size());
     if (!kind) {  // from inside a closed scene: every mode hits something

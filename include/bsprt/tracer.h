@@ -37,7 +37,7 @@ class Tracer {
   ///    exact reference's), "float" (certified epsilons, float watertight leaf),
   ///    "zero-eps" (float leaves without the epsilons), "top" (a box top over
   ///    the BSP, exact leaves), "top-float"; "top-certified" is "top";
-  ///  - kd-trees: "float".
+  ///  - kd-trees: "certified" (the default: exact leaves, --accel kd) or "float" (kd-float).
   /// Any `--accel` name of that tree kind (e.g. "bsp-float") is accepted too.
   /// Throws UsageError for a mode the tree kind has not.
   Tracer(const Scene& scene, const Tree& tree, std::string_view mode = "certified");

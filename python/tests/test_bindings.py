@@ -90,7 +90,7 @@ def test_bad_files_raise_input_error(tmp_path, scenes):
 
 @pytest.mark.parametrize("accel,mode,cli_mode", [("bsp", "certified", "bsp"), ("bsp", "float", "bsp-float"),
                                                  ("bsp", "top", "bsp-top"), ("bsp", "top-float", "bsp-top-float"),
-                                                 ("kd", "float", "kd")])
+                                                 ("kd", "certified", "kd"), ("kd", "float", "kd-float")])
 def test_trace_equals_cli(tmp_path, suzanne, accel, mode, cli_mode):
     rays_path, tree_path, hits_path = tmp_path / "r.rays", tmp_path / "t.tree", tmp_path / "h.hits"
     cli("gen-rays", suzanne, "--kind", "vertex", "-n", 3000, "-o", rays_path)
@@ -175,8 +175,10 @@ def test_bad_rays_raise_value_error(suzanne):
         bsprt.Tracer(scene)
     with pytest.raises(ValueError):
         bsprt.Tracer(scene, accel="no-such-accel")
+    kd_tree = scene.build(accel="kd")
+    assert bsprt.Tracer(scene, kd_tree, mode="certified").name == "kd"  # exact leaves on kd-trees too
     with pytest.raises(ValueError):
-        bsprt.Tracer(scene, scene.build(accel="kd"), mode="certified")
+        bsprt.Tracer(scene, kd_tree, mode="top")
     with pytest.raises(ValueError):
         scene.build(accel="octree")
 

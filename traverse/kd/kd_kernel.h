@@ -24,6 +24,7 @@ struct KdView {
   const std::uint32_t* prims;
   const KdTriangle* triangles;  ///< by triangle number
   Box3f bounds;
+  const LeafIntersector* exact_leaf = nullptr;  ///< exact-decision leaf test, or null = watertight float
 };
 
 /// Single-ray trace used by kernels for incoherent packets.

@@ -11,7 +11,9 @@
 /// without a stack entry. Hence hits and counters equal single rays exactly.
 /// Raw arrays only: no std:: templates are instantiated for this ISA.
 
+#include <bit>
 #include <cstdint>
+#include <span>
 
 #include "traverse/kd/kd_kernel.h"
 #include "traverse/simd/watertight_packet.h"
@@ -60,6 +62,25 @@ inline void widen(vfloat<W> t, vfloat<W>& lo, vfloat<W>& hi) {
   hi = a > b ? a : b;
 }
 
+/// The exact leaf test (v.exact_leaf) for each active lane, one ray at a time:
+/// the lane's NearestHit keeps the exact order and the answer, hit.t its cull
+/// bound (cull_bound). Never counted (counted runs trace single rays).
+template <int W>
+inline void packet_exact_leaf(const KdView& v, const KdNode& n, const Ray* rays, NearestHit* nearest,
+                              PacketHit<W>& hit, vmask<W> active) {
+  const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
+  alignas(64) float t[W];
+  store<W>(t, hit.t);
+  for (unsigned m = movemask<W>(active); m != 0; m &= m - 1) {
+    const int lane = std::countr_zero(m);
+    for (std::uint32_t i = first; i < end; ++i)
+      v.exact_leaf->intersect(rays[lane], std::span<const std::uint32_t>(v.prims + i, 1), &v.triangles[v.prims[i]],
+                              nearest[lane], nullptr);
+    t[lane] = cull_bound(nearest[lane]);
+  }
+  hit.t = load<W>(t);
+}
+
 template <int W, bool kCount>
 inline void packet_leaf(const KdView& v, const KdNode& n, const WatertightPacket<W>& pre,
                         PacketHit<W>& hit, vmask<W> active, RayCounters* c) {
@@ -88,7 +109,7 @@ struct KdPacketLanes {
 /// that frames the scene never reach one.
 template <int W, bool kCount>
 void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3], PacketHit<W>& hit,
-                  RayCounters* c) {
+                  RayCounters* c, const Ray* rays = nullptr, NearestHit* nearest = nullptr) {
   WatertightPacket<W> pre;
   bool have_pre = false;
   const vfloat<W>(&o)[3] = r.o;
@@ -133,7 +154,9 @@ void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3],
       }
       n = &v.nodes[node];
     }
-    if (n->is_leaf()) {
+    if (n->is_leaf() && nearest) {
+      packet_exact_leaf<W>(v, *n, rays, nearest, hit, active);
+    } else if (n->is_leaf()) {
       if (!have_pre) {
         pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
         have_pre = true;
@@ -172,6 +195,12 @@ void trace_packets(const KdView& v, const Ray* rays, std::size_t n, Hit* hits, R
     }
     if constexpr (kCount) c->rays += std::uint64_t(count);
     PacketHit<W> hit = packet_miss<W>();
+    if (v.exact_leaf) {  // exact leaves: never counted here (see packet_exact_leaf)
+      NearestHit nearest[W];
+      if (any<W>(r.valid)) trace_packet<W, false>(v, r, neg, hit, nullptr, rays + base, nearest);
+      for (int i = 0; i < count; ++i) hits[base + std::size_t(i)] = nearest[i].hit;
+      continue;
+    }
     if (any<W>(r.valid)) trace_packet<W, kCount>(v, r, neg, hit, c);
     store_hits<W>(hit, std::span<Hit>(hits + base, std::size_t(count)));
   }

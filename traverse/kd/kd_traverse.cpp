@@ -38,11 +38,22 @@ inline void clip_root(const Box3f& b, const float o[3], const float inv[3], cons
   }
 }
 
-/// Tests the triangles of a leaf.
+/// Tests the triangles of a leaf. With an exact leaf test, `nearest` keeps the
+/// exact order and the answer; hit then holds its prim and, as t, the cull
+/// bound (cull_bound).
 template <bool kCount>
-inline void intersect_leaf(const KdView& v, const KdNode& n, const WatertightRay& wr, Hit& hit,
-                           RayCounters* c) {
+inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, const WatertightRay& wr, Hit& hit,
+                           NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
+  if (v.exact_leaf) {
+    if constexpr (kCount) ++c->leaf_visits;
+    for (std::uint32_t i = first; i < end; ++i)  // corners by triangle number: one prim per call
+      v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + i, 1), &v.triangles[v.prims[i]], nearest,
+                              kCount ? c : nullptr);
+    hit.prim = nearest.hit.prim;
+    hit.t = cull_bound(nearest);
+    return;
+  }
   if constexpr (kCount) {
     ++c->leaf_visits;
     c->triangle_tests += n.prim_count();
@@ -62,9 +73,10 @@ inline void intersect_leaf(const KdView& v, const KdNode& n, const WatertightRay
 /// step measured 30% slower). A popped cell is skipped when its entry is past
 /// the nearest hit. kd_packet.inl repeats these steps lane by lane, bit for bit.
 template <bool kCount, bool kNonNegative>
-Hit trace_from(const KdView& v, const WatertightRay& wr, const float o[3],
+Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, const float o[3],
                const float inv[3], const bool neg[3], float tmin, float tmax, RayCounters* c) {
   Hit hit;
+  NearestHit nearest;
   StackEntry stack[kKdMaxDepth];
   int sp = 0;
   std::uint32_t node = 0;
@@ -91,8 +103,8 @@ Hit trace_from(const KdView& v, const WatertightRay& wr, const float o[3],
       if (!detail::step_near_far(near, far, go_near, go_far, th, tl, node, tmin, tmax, stack, sp)) break;
       n = &v.nodes[node];
     }
-    if (n->is_leaf()) intersect_leaf<kCount>(v, *n, wr, hit, c);
-    if (!detail::pop_before(stack, sp, hit.t, node, tmin, tmax)) return hit;
+    if (n->is_leaf()) intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
+    if (!detail::pop_before(stack, sp, hit.t, node, tmin, tmax)) return v.exact_leaf ? nearest.hit : hit;
   }
 }
 
@@ -108,8 +120,18 @@ Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
   float tmin = ray.tnear, tmax = ray.tfar;
   clip_root(v.bounds, o, inv, neg, tmin, tmax);
   if (!(tmin <= tmax)) return hit;
-  return tmin >= 0.0f ? trace_from<kCount, true>(v, wr, o, inv, neg, tmin, tmax, c)
-                      : trace_from<kCount, false>(v, wr, o, inv, neg, tmin, tmax, c);
+  const auto walk = [&]() {
+    return tmin >= 0.0f ? trace_from<kCount, true>(v, ray, wr, o, inv, neg, tmin, tmax, c)
+                        : trace_from<kCount, false>(v, ray, wr, o, inv, neg, tmin, tmax, c);
+  };
+  if constexpr (kCount) {
+    const std::uint64_t before = c->exact_decisions;  // set by an exact leaf test
+    const Hit h = walk();
+    c->exact_rays += c->exact_decisions != before;
+    return h;
+  } else {
+    return walk();
+  }
 }
 
 Hit trace_single_counted(const KdView& v, const Ray& ray, RayCounters* c) {
@@ -139,15 +161,17 @@ KdTracer::KdTracer(KdTree tree, const TriangleSoup& soup) : tree_(std::move(tree
 }
 
 Hit KdTracer::trace(const Ray& ray, RayCounters* counters) const {
-  const KdView v{tree_.nodes.data(), tree_.prims.data(), triangles_.data(), tree_.bounds};
+  const KdView v{tree_.nodes.data(), tree_.prims.data(), triangles_.data(), tree_.bounds, exact_leaf_};
   return counters ? trace_single<true>(v, ray, counters) : trace_single<false>(v, ray, nullptr);
 }
 
 void KdTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
                            RayCounters* counters) const {
   const Isa need = check_trace_batch(rays.size(), hits.size(), packet_width);
-  const KdView v{tree_.nodes.data(), tree_.prims.data(), triangles_.data(), tree_.bounds};
-  switch (need) {
+  const KdView v{tree_.nodes.data(), tree_.prims.data(), triangles_.data(), tree_.bounds, exact_leaf_};
+  // Exact leaves when counted: single rays (the packet kernels count no exact
+  // decisions; the counts are the same).
+  switch (exact_leaf_ && counters ? Isa::Scalar : need) {
     case Isa::Scalar:
       for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace_single_counted(v, rays[i], counters);
       break;

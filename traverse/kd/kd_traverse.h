@@ -13,6 +13,7 @@
 
 #include "geometry/core/triangle_soup.h"
 #include "traverse/kd/kd_tree.h"
+#include "traverse/leaf_intersector.h"
 #include "traverse/accelerator.h"
 
 namespace bsprt {
@@ -23,9 +24,7 @@ inline constexpr int kKdMaxDepth = 64;
 /// A triangle's corners (36 bytes), copied from the soup by triangle number: one
 /// copy per triangle, not per leaf reference (a smaller footprint measured
 /// faster than leaf-ordered copies, which duplicate ~6x on scanned meshes).
-struct KdTriangle {
-  Vec3f v[3];
-};
+using KdTriangle = LeafTriangle;
 
 /// The kd-tree behind the Accelerator interface. Copies the triangle corners it
 /// needs, so the soup need not outlive it.
@@ -36,7 +35,14 @@ class KdTracer final : public Accelerator {
   /// for a scene with another triangle count.
   KdTracer(KdTree tree, const TriangleSoup& soup);
 
-  std::string name() const override { return "kd"; }
+  /// kd with an exact leaf test (set_exact_leaf), else kd-float.
+  std::string name() const override { return exact_leaf_ ? "kd" : "kd-float"; }
+  /// Tests leaves with `exact` (robust/certified_intersector.h) instead of the
+  /// float watertight test; it must outlive the tracer. The traversal is
+  /// conservative and culls against cull_bound, so the nearest hit then equals
+  /// the exact reference's. Packets run the exact test lane by lane; counted
+  /// packets run as single rays.
+  void set_exact_leaf(const LeafIntersector* exact) { exact_leaf_ = exact; }
   /// Single ray, front to back; counts kd_node_visits, leaf_visits,
   /// triangle_tests and rays when `counters` is non-null.
   Hit trace(const Ray& ray, RayCounters* counters = nullptr) const override;
@@ -53,6 +59,7 @@ class KdTracer final : public Accelerator {
  private:
   KdTree tree_;
   std::vector<KdTriangle> triangles_;  ///< corners of triangle i (all of the soup)
+  const LeafIntersector* exact_leaf_ = nullptr;
 };
 
 }  // namespace bsprt
