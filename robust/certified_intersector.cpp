@@ -337,6 +337,9 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     // the triangle alone, so it would return the same candidate, which is not
     // nearer than itself.
     if (best.hit.hit() && prim == best.hit.prim) continue;
+    // Degenerate triangles (collinear or non-finite corners) never hit; a
+    // non-finite corner must not reach the exact stage (Mpzf takes finite doubles).
+    if (soup_.is_degenerate(prim)) continue;
     const std::array<Vec3f, 3> tri =
         corners ? std::array<Vec3f, 3>{corners[i].v[0], corners[i].v[1], corners[i].v[2]} : soup_.corners(prim);
     const std::optional<Candidate> c = test_one(ray, fr, tri, st);
@@ -381,6 +384,7 @@ void CertifiedIntersector::crossings(const Ray& ray, std::span<const std::uint32
   Stages st;
   for (const std::uint32_t prim : prims) {
     if (counters) ++counters->triangle_tests;
+    if (soup_.is_degenerate(prim)) continue;  // never crossed (and never handed to Mpzf)
     const std::array<Vec3f, 3> tri = soup_.corners(prim);
     const std::optional<Candidate> c = test_one(ray, fr, tri, st, true);
     if (!c) continue;
