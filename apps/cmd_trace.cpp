@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <fstream>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "apps/cli_common.h"
 #include "apps/progress.h"
@@ -17,6 +19,8 @@
 #include "builder/tree_file.h"
 #include "bsprt/error.h"
 #include "bsprt/io.h"
+#include "robust/certified_intersector.h"
+#include "robust/exact_tracer.h"
 #include "traverse/embree/embree_tracer.h"
 #include "traverse/trace_parallel.h"
 
@@ -29,8 +33,50 @@ struct TraceArgs {
   bool json = false;
   bool stats = false;
   bool face_hits = false;
+  bool all_hits = false;  ///< every crossing, exact (robust/certified_intersector.h), to a CSV
+  bool occluded = false;  ///< any hit in [tnear, tfar] per ray, to a text file of 0 and 1
+  bool accel_given = false, tree_given = false;
   int passes = 1;  ///< timing passes; the fastest counts
 };
+
+/// --all-hits: every crossing of every ray, exactly, with simulation of
+/// simplicity, from the exact reference's candidates: one line per crossing,
+/// "ray,prim,t,side", ordered by ray, then t, then triangle.
+void run_all_hits(const TraceArgs& a) {
+  if (a.accel_given || a.tree_given)
+    throw UsageError("--all-hits is decided exactly from the exact reference's AABB tree; drop --accel and --tree");
+  const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, !a.json);
+  const std::vector<Ray> rays = read_rays(a.rays);
+  const auto t0 = std::chrono::steady_clock::now();
+  const ExactTracer exact(soup);
+  const CertifiedIntersector cert(soup);
+  std::vector<std::vector<CertifiedIntersector::Crossing>> per_ray(rays.size());
+  tbb::combinable<RayCounters> counters;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
+    std::vector<std::uint32_t> candidates;
+    for (std::size_t i = r.begin(); i < r.end(); ++i) {
+      exact.touched(rays[i], candidates);
+      cert.crossings(rays[i], candidates, per_ray[i], &counters.local());
+      std::sort(per_ray[i].begin(), per_ray[i].end(),
+                [](const auto& x, const auto& y) { return x.t < y.t || (x.t == y.t && x.prim < y.prim); });
+    }
+  });
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::ofstream out(a.hits);
+  if (!out) throw InputError(a.hits, "cannot write");
+  out << "ray,prim,t,side\n";
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    for (const auto& x : per_ray[i]) {
+      out << fmt::format("{},{},{},{}\n", i, x.prim, x.t, x.side);
+      ++total;
+    }
+  if (!out) throw InputError(a.hits, "write failed");
+  const RayCounters c = counters.combine([](RayCounters x, const RayCounters& y) { return x += y; });
+  fmt::print("all hits: {} rays, {} crossings ({:.3f} per ray), {:.3f} s, {:.4f} exact decisions per ray; wrote {}\n",
+             rays.size(), total, rays.empty() ? 0.0 : double(total) / double(rays.size()), s,
+             rays.empty() ? 0.0 : double(c.exact_decisions) / double(rays.size()), a.hits);
+}
 
 /// --face-hits: how many nearest hits a face-plane split proves
 /// (builder/bsp_face_hits.h, docs/certified-epsilons.md §8).
@@ -71,6 +117,10 @@ RayCounters trace_all(const Accelerator& tracer, const std::vector<Ray>& rays, s
 
 void run(const TraceArgs& a) {
   const auto threads = limit_threads(a.trace.threads);
+  if (a.all_hits && (a.occluded || a.face_hits || a.stats))
+    throw UsageError("--all-hits writes crossings; it does not combine with --occluded, --face-hits or --stats");
+  if (a.all_hits) return run_all_hits(a);
+  if (a.occluded && a.face_hits) throw UsageError("--occluded does not combine with --face-hits");
   if (a.face_hits) check_face_hits_usage(a);
   const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, !a.json);
   const std::vector<Ray> rays = read_rays(a.rays);
@@ -92,7 +142,14 @@ void run(const TraceArgs& a) {
     trace_s = std::min(trace_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
   }
   const RayCounters c = a.stats ? trace_all(*tracer, rays, hits, a.trace.packets, true) : RayCounters{};
-  write_hits(a.hits, hits);
+  if (a.occluded) {  // any hit in [tnear, tfar]: the nearest one decides (exact with a certified accelerator)
+    std::ofstream out(a.hits);
+    if (!out) throw InputError(a.hits, "cannot write");
+    for (const Hit& h : hits) out << (h.hit() ? "1\n" : "0\n");
+    if (!out) throw InputError(a.hits, "write failed");
+  } else {
+    write_hits(a.hits, hits);
+  }
   const FaceHitFigures face = a.face_hits ? count_face_hits(a, soup, hits) : FaceHitFigures{};
 
   std::size_t nhit = 0;
@@ -146,13 +203,22 @@ void register_trace(CLI::App& app) {
   cmd->add_option("RAYS", args->rays, ".rays file (see `bsprt gen-rays`)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->hits, ".hits file to write")->required();
   add_trace_options(*cmd, args->trace, "embree");
+  cmd->add_flag("--all-hits", args->all_hits,
+                "write every crossing of every ray, exactly (simulation of simplicity: a ray through a shared edge "
+                "or vertex crosses one triangle of each sheet), as CSV ray,prim,t,side, instead of a .hits file");
+  cmd->add_flag("--occluded", args->occluded,
+                "write 1 (a hit in [tnear, tfar]) or 0 per ray, as text, instead of a .hits file");
   cmd->add_flag("--json", args->json, "print one JSON object instead of text");
   cmd->add_flag("--stats", args->stats, "count and print node visits and triangle tests per ray");
   cmd->add_option("--passes", args->passes, "timing passes over the rays; the fastest is reported (hits are the same each pass)")
       ->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_flag("--face-hits", args->face_hits,
                 "bsp: count hits that a split on the hit triangle's own face plane proves (needs --tree)");
-  cmd->callback([args] { run(*args); });
+  cmd->callback([args, cmd] {
+    args->accel_given = cmd->count("--accel") > 0;
+    args->tree_given = cmd->count("--tree") > 0;
+    run(*args);
+  });
 }
 
 }  // namespace bsprt::cli

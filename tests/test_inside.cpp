@@ -8,6 +8,7 @@
 #include <CGAL/Surface_mesh.h>
 
 #include <catch2/catch.hpp>
+#include <fmt/core.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -23,6 +24,7 @@
 #include "robust/certified_intersector.h"
 #include "robust/degenerate.h"
 #include "robust/inside_query.h"
+#include "bsprt/io.h"
 #include "test_util.h"
 
 namespace bsprt {
@@ -194,6 +196,60 @@ TEST_CASE("inside: open meshes are reported; CLI answers per point and rejects b
   INFO(open.output);
   CHECK(open.status == 0);
   CHECK(open.output.find("warning:") != std::string::npos);
+}
+
+}  // namespace bsprt
+
+namespace bsprt {
+
+TEST_CASE("trace --all-hits equals exact brute-force crossings; --occluded equals the exact hits", "[inside][cli]") {
+  const std::string scene = test::scene_path("suzanne.obj"), rays = test::temp_path("allhits.rays");
+  for (const char* kind : {"vertex", "edge"}) {
+    INFO(kind);
+    REQUIRE(test::bsprt_cli("gen-rays " + scene + " --kind " + std::string(kind) + " -n 1500 --seed 4 -o " + rays)
+                .status == 0);
+    const std::string csv = test::temp_path("allhits.csv");
+    const test::CliRun r = test::bsprt_cli("trace " + scene + " " + rays + " --all-hits -o " + csv);
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    // The reference: every triangle, the same exact crossing decision.
+    TriangleSoup soup = load_mesh(scene);
+    classify_degenerate(soup);
+    const CertifiedIntersector cert(soup);
+    std::vector<std::uint32_t> all(soup.size());
+    for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+    std::vector<std::string> want = {"ray,prim,t,side"};
+    const std::vector<Ray> rs = read_rays(rays);
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+      std::vector<CertifiedIntersector::Crossing> xs;
+      cert.crossings(rs[i], all, xs, nullptr);
+      std::sort(xs.begin(), xs.end(), [](const auto& a, const auto& b) { return a.t < b.t || (a.t == b.t && a.prim < b.prim); });
+      for (const auto& x : xs) want.push_back(fmt::format("{},{},{},{}", i, x.prim, x.t, x.side));
+    }
+    std::ifstream in(csv);
+    std::vector<std::string> got;
+    for (std::string line; std::getline(in, line);) got.push_back(line);
+    CHECK(got.size() > rs.size());  // most rays cross the mesh at least twice
+    CHECK(got == want);
+    // --occluded: 1 exactly where the exact reference hits.
+    const std::string occ = test::temp_path("allhits.occ"), ref = test::temp_path("allhits.exact.hits");
+    REQUIRE(test::bsprt_cli("trace " + scene + " " + rays + " --occluded --accel bsp -o " + occ).status == 0);
+    REQUIRE(test::bsprt_cli("trace " + scene + " " + rays + " --accel exact -o " + ref).status == 0);
+    const std::vector<Hit> exact = read_hits(ref);
+    std::ifstream o(occ);
+    std::size_t i = 0, ones = 0;
+    for (std::string line; std::getline(o, line); ++i) {
+      REQUIRE(i < exact.size());
+      CHECK(line == (exact[i].hit() ? "1" : "0"));
+      ones += line == "1";
+    }
+    CHECK(i == exact.size());
+    CHECK(ones > 0);
+  }
+  CHECK(test::bsprt_cli("trace " + scene + " " + rays + " --all-hits --accel bsp -o " + test::temp_path("x.csv"))
+            .status == 2);
+  CHECK(test::bsprt_cli("trace " + scene + " " + rays + " --all-hits --occluded -o " + test::temp_path("x.csv"))
+            .status == 2);
 }
 
 }  // namespace bsprt
