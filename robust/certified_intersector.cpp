@@ -167,7 +167,6 @@ FilterRay filter_ray(const Ray& ray) {
   return f;
 }
 
-/// Decides one triangle; nullopt = no hit with t in [tnear, tfar].
 /// Simulation of simplicity for a weight that is exactly 0: its sign when the
 /// origin moves to o + (e, e^2, e^3) for an infinitesimal e > 0. The weight
 /// pairing p and q (in this order) becomes w - delta.((q - p) x d), so its sign

@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <optional>
 #include <vector>
 
@@ -24,6 +23,9 @@ using TriangleList = std::vector<Epick::Triangle_3>;
 using Primitive = CGAL::AABB_triangle_primitive<Epick, TriangleList::const_iterator>;
 using AabbTree = CGAL::AABB_tree<CGAL::AABB_traits<Epick, Primitive>>;
 using FT = Epeck::FT;
+
+/// FLT_MAX + half an ulp: an exact t at or beyond it rounds to infinity (robust/nearest_float.h).
+constexpr double kFloatOverflow = 0x1.ffffffp127;
 
 Epick::Point_3 to_epick(const Vec3f& p) { return {p.x, p.y, p.z}; }
 Epeck::Point_3 to_epeck(const Vec3f& p) { return {p.x, p.y, p.z}; }
@@ -182,18 +184,18 @@ Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
     const std::optional<Candidate> cand = ray.tnear >= 0.0f ? exact_hit(tri, exact_ray, o, d, tnear, tfar)
                                                             : exact_hit(tri, exact_line, o, d, tnear, tfar);
     if (!cand) continue;
+    // A hit beyond the float range (its t rounds to +-inf) is not a hit, in every
+    // mode (docs/exact-leaf-test.md, "Hits beyond the float range"); with
+    // tnear = -inf a farther, finite hit can then still be the nearest.
+    if (cand->t <= FT(-kFloatOverflow) || cand->t >= FT(kFloatOverflow)) continue;
     if (!best_t || cand->t < *best_t || (cand->t == *best_t && t < best_prim)) {
       best_t = cand->t, best_p = cand->p, best_prim = t;
     }
   }
   if (!best_t) return best;
-  // A hit beyond the float range (t rounds to +inf, or -inf when tnear = -inf) is a miss, in every mode
-  // (docs/exact-leaf-test.md, "Hits beyond the float range").
-  const float t_float = nearest_float(*best_t);
-  if (std::isinf(t_float)) return best;
   const auto [a, b, c] = impl_->soup.corners(best_prim);
   const auto [u, v] = barycentrics(*best_p, to_epeck(a), to_epeck(b), to_epeck(c));
-  best.t = t_float;
+  best.t = nearest_float(*best_t);
   best.prim = best_prim;
   best.u = u;
   best.v = v;

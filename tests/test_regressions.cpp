@@ -2,6 +2,7 @@
 // failure becomes one test here, with the input written out in code.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <limits>
 #include <utility>
@@ -174,7 +175,27 @@ TEST_CASE("exact reference: a hit beyond the float range is a miss in every mode
     REQUIRE_NOTHROW(h = t->trace(ray_of({0.25f, 0.25f, 2}, {0, 0, 0x1p-27f})));
     CHECK(h.prim == 1);
     CHECK(h.t == 0x1p127f);
-    // Behind the origin, the same magnitude: -infinity is below tnear = 0, so no hit.
-    CHECK(!t->trace(ray_of({0.25f, 0.25f, 0}, {0, 0, -1e-40f})).hit());
+  }
+}
+
+// Found reviewing issue #23's change: with tnear = -inf, the exact reference
+// took the nearest exact t first and then dropped it for rounding to -inf,
+// reporting a miss, while the certified test skips such a triangle and keeps
+// a farther, finite hit. A hit beyond the float range is no hit; the next one counts.
+TEST_CASE("exact reference: a hit rounding to -inf is skipped, a farther finite hit is the nearest",
+          "[regression]") {
+  TriangleSoup s;
+  add_tri(s, {-1, -1, 1}, {3, -1, 1}, {-1, 3, 1});                                   // t = -1e40
+  add_tri(s, {-1, -1, 2 + 0x1p-10f}, {3, -1, 2 + 0x1p-10f}, {-1, 3, 2 + 0x1p-10f});  // t = 2^-10 / 1e-40
+  const ExactTracer exact(s);
+  const CertifiedBruteTracer certified(s);
+  Ray r = ray_of({0.25f, 0.25f, 2}, {0, 0, 1e-40f});
+  r.tnear = -std::numeric_limits<float>::infinity();
+  for (const Accelerator* t : {static_cast<const Accelerator*>(&exact), static_cast<const Accelerator*>(&certified)}) {
+    CAPTURE(t->name());
+    const Hit h = t->trace(r);
+    CHECK(h.prim == 1);
+    CHECK(std::isfinite(h.t));
+    CHECK(h.t > 1e36f);
   }
 }
