@@ -76,7 +76,8 @@ struct Candidate {
 /// bsprt tracer shares, so the reference measures the same thing.
 template <typename Query>
 std::optional<Candidate> exact_hit(const Epeck::Triangle_3& tri, const Query& query, const Epeck::Point_3& o,
-                                   const Epeck::Vector_3& d, const FT& tnear, const std::optional<FT>& tfar) {
+                                   const Epeck::Vector_3& d, const std::optional<FT>& tnear,
+                                   const std::optional<FT>& tfar) {
   // A line parallel to the plane misses, also where it touches the triangle
   // at a single corner or edge point in its plane (CGAL reports a Point_3 then).
   // Regression test "exact reference: a ray in a triangle's plane touching a corner misses".
@@ -87,7 +88,7 @@ std::optional<Candidate> exact_hit(const Epeck::Triangle_3& tri, const Query& qu
   const auto* p = boost::get<Epeck::Point_3>(&*hit);
   if (!p) return std::nullopt;
   const FT t = param(*p, o, d);
-  if (t < tnear || (tfar && t > *tfar)) return std::nullopt;
+  if ((tnear && t < *tnear) || (tfar && t > *tfar)) return std::nullopt;
   return Candidate{t, *p};
 }
 
@@ -172,7 +173,8 @@ Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
   const Epeck::Vector_3 d(ray.dir.x, ray.dir.y, ray.dir.z);
   const Epeck::Ray_3 exact_ray(o, d);
   const Epeck::Line_3 exact_line(o, d);
-  const FT tnear = ray.tnear;
+  // An infinite bound is no bound (an FT cannot hold one: CGAL asserts finiteness).
+  const std::optional<FT> tnear = std::isfinite(ray.tnear) ? std::optional<FT>(FT(ray.tnear)) : std::nullopt;
   const std::optional<FT> tfar = std::isfinite(ray.tfar) ? std::optional<FT>(FT(ray.tfar)) : std::nullopt;
   std::optional<FT> best_t;
   std::optional<Epeck::Point_3> best_p;
