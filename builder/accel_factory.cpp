@@ -18,6 +18,8 @@
 #include "traverse/embree/embree_tracer.h"
 #include "traverse/bsp/bsp_traverse.h"
 #include "traverse/embree/box_top_build.h"
+#include "traverse/embree/bvh8_build.h"
+#include "traverse/bvh/bvh8_traverse.h"
 #include "traverse/kd/kd_traverse.h"
 
 namespace bsprt {
@@ -47,48 +49,38 @@ std::unique_ptr<Accelerator> make_kd_float(const TriangleSoup& soup, const Accel
   return std::make_unique<KdTracer>(load_or_build_kd(soup, options), soup);
 }
 
-/// A kd tracer whose leaves use the exact-decision test (owns that test).
-class CertifiedKdTracer final : public Accelerator {
+/// A tracer (KdTracer, BspTracer, Bvh8Tracer) whose leaves use the
+/// exact-decision test, which it owns; `tracer()` finishes the setup.
+template <typename Tracer>
+class ExactLeafTracer final : public Accelerator {
  public:
-  CertifiedKdTracer(KdTree tree, const TriangleSoup& soup) : exact_(soup), kd_(std::move(tree), soup) {
-    kd_.set_exact_leaf(&exact_);
+  template <typename... Args>
+  explicit ExactLeafTracer(const TriangleSoup& soup, Args&&... args)
+      : exact_(soup), tracer_(std::forward<Args>(args)...) {
+    tracer_.set_exact_leaf(&exact_);
   }
-  std::string name() const override { return kd_.name(); }
-  Hit trace(const Ray& ray, RayCounters* counters) const override { return kd_.trace(ray, counters); }
+  Tracer& tracer() { return tracer_; }
+  std::string name() const override { return tracer_.name(); }
+  Hit trace(const Ray& ray, RayCounters* counters) const override { return tracer_.trace(ray, counters); }
   void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
                    RayCounters* counters) const override {
-    kd_.trace_batch(rays, hits, packet_width, counters);
+    tracer_.trace_batch(rays, hits, packet_width, counters);
   }
-  std::size_t memory_bytes() const override { return kd_.memory_bytes(); }
+  std::size_t memory_bytes() const override { return tracer_.memory_bytes(); }
 
  private:
-  CertifiedIntersector exact_;
-  KdTracer kd_;
+  CertifiedIntersector exact_;  // before tracer_: constructed first, destroyed last
+  Tracer tracer_;
 };
 
-/// A BSP tracer whose leaves use the exact-decision test (owns that test).
-class CertifiedBspTracer final : public Accelerator {
- public:
-  /// top_slots > 0: under a box top of subtrees of at most that many slots.
-  CertifiedBspTracer(FlatBspTree flat, const TriangleSoup& soup, std::uint32_t top_slots = 0,
-                     BspSingleRays single_rays = BspSingleRays::Auto)
-      : exact_(soup), bsp_(std::move(flat), soup, BspEpsilon::Certified) {
-    bsp_.set_exact_leaf(&exact_);
-    bsp_.set_single_rays(single_rays);
-    if (top_slots > 0) add_box_top(bsp_, top_slots);
-  }
-  std::string name() const override { return bsp_.name(); }
-  Hit trace(const Ray& ray, RayCounters* counters) const override { return bsp_.trace(ray, counters); }
-  void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
-                   RayCounters* counters) const override {
-    bsp_.trace_batch(rays, hits, packet_width, counters);
-  }
-  std::size_t memory_bytes() const override { return bsp_.memory_bytes(); }
-
- private:
-  CertifiedIntersector exact_;
-  BspTracer bsp_;
-};
+/// bsp or bsp-top: the BSP with exact leaves; top_slots > 0 puts it under a box top.
+std::unique_ptr<Accelerator> make_exact_bsp(const TriangleSoup& soup, FlatBspTree flat, std::uint32_t top_slots,
+                                            BspSingleRays single_rays) {
+  auto t = std::make_unique<ExactLeafTracer<BspTracer>>(soup, std::move(flat), soup, BspEpsilon::Certified);
+  t->tracer().set_single_rays(single_rays);
+  if (top_slots > 0) add_box_top(t->tracer(), top_slots);
+  return t;
+}
 
 /// The flat BSP tree: read from the file (its flat sections, or flattened from
 /// its exact sections), or built and flattened in memory.
@@ -150,14 +142,14 @@ constexpr AccelInfo kTable[] = {
     {"kd", "SAH kd-tree, conservative traversal, exact-decision leaf test (the default)", A::Kd, true, true, false,
      false, false, false,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return std::make_unique<CertifiedKdTracer>(load_or_build_kd(s, o), s);
+       return std::make_unique<ExactLeafTracer<KdTracer>>(s, load_or_build_kd(s, o), s);
      }},
     {"kd-float", "SAH kd-tree, float watertight leaf test", A::Kd, false, true, false, false, false, false,
      make_kd_float},
     {"bsp", "exact BSP, certified traversal, exact-decision leaf test (the default)", A::Bsp, true, true, false,
      false, true, false,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(s, o), s, 0, o.single_rays);
+       return make_exact_bsp(s, load_or_build_bsp(s, o), 0, o.single_rays);
      }},
     {"bsp-float", "exact BSP, certified float traversal, float watertight leaf test", A::Bsp, false, true, false,
      false, true, false,
@@ -173,7 +165,17 @@ constexpr AccelInfo kTable[] = {
     {"bsp-top", "the BSP under a 4-wide box top, single rays, exact-decision leaf test", A::Bsp, true, false, false,
      false, false, true,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return std::make_unique<CertifiedBspTracer>(load_or_build_bsp(s, o), s, o.top_slots);
+       return make_exact_bsp(s, load_or_build_bsp(s, o), o.top_slots, BspSingleRays::Auto);
+     }},
+    {"bvh8", "plain 8-wide BVH (Embree's SAH builder), Embree-style single-ray kernel, exact-decision leaf test",
+     A::None, true, false, false, false, false, false,
+     [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
+       return std::make_unique<ExactLeafTracer<Bvh8Tracer>>(s, with_threads(o.threads, [&] { return build_bvh8(s); }));
+     }},
+    {"bvh8-float", "plain 8-wide BVH, Embree-style single-ray kernel, float watertight leaf test", A::None, false,
+     false, false, false, false, false,
+     [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
+       return std::make_unique<Bvh8Tracer>(with_threads(o.threads, [&] { return build_bvh8(s); }));
      }},
 };
 

@@ -10,7 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/configure-instrumented.sh
-targets="test_geometry test_traverse test_exact test_kd test_bsp test_bsp_traverse test_stiff"
+targets="test_geometry test_traverse test_exact test_kd test_bvh8 test_bsp test_bsp_traverse test_stiff"
 cmake --build build-fuzz --target $targets -j "$(nproc)"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

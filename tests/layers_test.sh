@@ -2,7 +2,7 @@
 # CTest "include_layers": no include runs up a layer. The folders, bottom up
 # (each library may include its own folder and the ones below it):
 #   0 include/bsprt, geometry/core   public types, triangle soup      bsprt::core
-#   1 traverse (kd/, bsp/, simd/)    float traversal, no CGAL         bsprt::traverse
+#   1 traverse (kd/, bsp/, bvh/, simd/) float traversal, no CGAL     bsprt::traverse
 #   2 traverse/embree                Embree behind Accelerator        bsprt::embree
 #   3 robust                         exact predicates (CGAL)          bsprt::robust
 #   4 geometry/io, geometry/scenes   files, made scenes and rays      bsprt::geometry

@@ -24,7 +24,7 @@ namespace bsprt::test {
 
 /// Every tracer of one scene, made from the accelerator table; `soup` must outlive it.
 struct ModeSet {
-  /// kd-float, kd and bsp (exact leaves), bsp-float, bsp-top and bsp-top-float (box tops over
+  /// kd-float, kd, bvh8-float, bvh8 and bsp (exact leaves), bsp-float, bsp-top and bsp-top-float (box tops over
   /// 8-slot subtrees: many boxes even on small scenes) (+ embree when asked);
   /// the BSP modes share one build, handed to them as an in-memory tree file.
   std::vector<std::unique_ptr<Accelerator>> modes;
@@ -33,6 +33,8 @@ struct ModeSet {
   ModeSet(const TriangleSoup& soup, bool with_embree, bool with_exact = true) {
     modes.push_back(make_tracer("kd-float", soup));
     modes.push_back(make_tracer("kd", soup));
+    modes.push_back(make_tracer("bvh8-float", soup));
+    modes.push_back(make_tracer("bvh8", soup));
     BspConfig config;
     config.threads = 1;
     const BspTree tree = build_bsp(soup, config);

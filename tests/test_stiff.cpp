@@ -1,8 +1,8 @@
 // Stiff and extreme cases (geometry/stiff_scenes.h, geometry/stiff_rays.h):
-// for each scene build kd and BSP, trace every stiff ray set with kd, bsp,
-// bsp (exact leaves), bsp-top-float and bsp-top, and compare with the exact
-// reference ray by ray.
-// Asserted: bsp and bsp-top (exact leaves) equal the exact reference (nothing lost, extra,
+// for each scene build kd, BVH8 and BSP, trace every stiff ray set with
+// kd-float, kd, bvh8-float, bvh8, bsp-float, bsp (exact leaves),
+// bsp-top-float and bsp-top, and compare with the exact reference ray by ray.
+// Asserted: kd, bvh8, bsp and bsp-top (exact leaves) equal the exact reference (nothing lost, extra,
 // farther or nearer); invalid rays miss in every mode; no ray from inside a
 // closed scene escapes in any mode. The float modes' differences from the
 // exact reference near vertices and edges are recorded, not asserted
@@ -46,7 +46,8 @@ void check_kind(const StiffScene& sc, const ModeSet& m, std::optional<StiffRayKi
                  << ", farther " << c.farther << ", nearer " << c.nearer << ", ties " << c.tie
                  << ", first bad ray " << c.first_bad_ray);
     row += fmt::format(" {}/{}/{}/{} {:.0f} |", c.lost, c.extra, c.farther, c.nearer, c.max_t_ulps);
-    if (t->name() == "kd" || t->name() == "bsp" || t->name() == "bsp-top" || t->name() == "brute-certified")
+    if (t->name() == "kd" || t->name() == "bvh8" || t->name() == "bsp" || t->name() == "bsp-top" ||
+        t->name() == "brute-certified")
       CHECK(c.agrees());
     if (kind == StiffRayKind::Invalid) CHECK(c.both_miss == rays.size());
     if (!kind) {  // from inside a closed scene: every mode hits something

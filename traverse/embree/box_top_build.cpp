@@ -10,6 +10,7 @@
 #include <string>
 
 #include "traverse/embree/box_top_build.h"
+#include "traverse/embree/build_device.h"
 
 namespace bsprt {
 namespace {
@@ -60,22 +61,6 @@ void set_child_box(BoxTopNode& n, int i, const Box3f& b) {
   for (int k = 0; k < 3; ++k) n.lo[k][i] = b.lo[k], n.hi[k][i] = b.hi[k];
 }
 
-/// One Embree device for every box-top build of the process: making a device
-/// starts Embree's worker threads, which would dominate the build of a small
-/// scene's top. Builds on it are serialized (build_box_top's lock): Embree
-/// promises thread safety only for calls on different objects.
-RTCDevice shared_device() {
-  struct Holder {
-    RTCDevice device = rtcNewDevice(nullptr);
-    ~Holder() {
-      if (device) rtcReleaseDevice(device);
-    }
-  };
-  static const Holder holder;
-  if (!holder.device) throw std::runtime_error("embree: rtcNewDevice failed");
-  return holder.device;
-}
-
 struct Flattener {
   std::span<const BspSubtreeBox> subtrees;
   BoxTop top;
@@ -124,9 +109,9 @@ BoxTop build_box_top(std::span<const BspSubtreeBox> subtrees) {
     const Box3f& b = subtrees[i].box;
     prims[i] = {b.lo.x, b.lo.y, b.lo.z, 0u, b.hi.x, b.hi.y, b.hi.z, std::uint32_t(i)};
   }
-  static std::mutex build_lock;  // rare (one build per tracer); Embree parallelizes each build itself
-  const std::lock_guard<std::mutex> lock(build_lock);
-  const RTCDevice device = shared_device();
+  // Rare (one build per tracer); Embree parallelizes each build itself.
+  const std::lock_guard<std::mutex> lock(detail::build_lock());
+  const RTCDevice device = detail::shared_build_device();
   RTCBVH bvh = rtcNewBVH(device);
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;

@@ -1,0 +1,225 @@
+// The plain BVH8 and its Embree-style single-ray kernel (issue #26, step one;
+// traverse/bvh/, docs/bvh8.md): the tree checks itself; with exact leaves the
+// hits equal the exact reference bit for bit on random, vertex, edge and
+// stiff rays, lines (tnear < 0) and short segments; with float leaves they
+// equal brute force; the plain x86-64 kernel equals the AVX2 one; and boxes
+// shrunk by one float step lose hits, so the tight boxes and the conservative
+// box test are what keeps them.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "builder/accel_factory.h"
+#include "bsprt/compare.h"
+#include "bsprt/error.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/scenes/default_scene.h"
+#include "geometry/scenes/ray_gen.h"
+#include "geometry/scenes/stiff_rays.h"
+#include "geometry/scenes/stiff_scenes.h"
+#include "robust/certified_intersector.h"
+#include "robust/exact_tracer.h"
+#include "test_util.h"
+#include "traverse/brute_force.h"
+#include "traverse/bvh/bvh8_traverse.h"
+#include "traverse/embree/bvh8_build.h"
+
+using namespace bsprt;
+
+namespace {
+
+struct Scene {
+  std::string name;
+  TriangleSoup soup;
+};
+
+std::vector<Scene> scenes() {
+  std::vector<Scene> s;
+  s.push_back({"suzanne", load_mesh(test::scene_path("suzanne.obj"))});
+  s.push_back({"teapot", load_mesh(test::scene_path("utah-teapot.obj"))});
+  s.push_back({"icosphere(5120)", make_icosphere({0.5f, -0.25f, 2}, 1.0f, 4)});
+  s.push_back({"ground(2048)", make_ground({0, 0, 0}, 1.0f, 32)});
+  s.push_back({"grid_box", make_stiff_scene("grid_box").soup});
+  return s;
+}
+
+/// Random, vertex and edge rays, the same as lines (tnear = -inf) and as short
+/// segments (tfar at a third of the scene's size).
+std::vector<Ray> test_rays(const TriangleSoup& soup, std::size_t n) {
+  std::vector<Ray> rays;
+  for (RaySetKind k : {RaySetKind::Random, RaySetKind::Vertex, RaySetKind::Edge}) {
+    const std::vector<Ray> r = make_rays(k, soup, n, 11 + std::uint64_t(k));
+    rays.insert(rays.end(), r.begin(), r.end());
+  }
+  const std::size_t base = rays.size();
+  const float size = length(soup.bounds().diagonal());
+  for (std::size_t i = 0; i < base; i += 3) {
+    Ray line = rays[i];
+    line.tnear = -std::numeric_limits<float>::infinity();
+    rays.push_back(line);
+    Ray seg = rays[i + 1];
+    seg.tfar = size / (3.0f * length(seg.dir));
+    rays.push_back(seg);
+  }
+  for (StiffRayKind k : {StiffRayKind::AxisParallel, StiffRayKind::AxisPlane, StiffRayKind::AlongEdge}) {
+    const std::vector<Ray> r = stiff_rays(k, soup, n / 4, 31 + std::uint64_t(k));
+    rays.insert(rays.end(), r.begin(), r.end());
+  }
+  return rays;
+}
+
+std::unique_ptr<Accelerator> exact_bvh8(const TriangleSoup& soup) { return make_tracer("bvh8", soup); }
+
+/// Rays whose hit differs from the reference's, in prim or in t.
+std::size_t differing(const Accelerator& ref, const Accelerator& t, const std::vector<Ray>& rays) {
+  std::size_t bad = 0;
+  for (const Ray& r : rays) {
+    const Hit a = ref.trace(r), b = t.trace(r);
+    bad += (a.prim != b.prim || (a.hit() && a.t != b.t)) ? 1 : 0;
+  }
+  return bad;
+}
+
+}  // namespace
+
+TEST_CASE("bvh8: the tree is valid, holds every usable triangle and catches corruption", "[bvh8]") {
+  for (const Scene& s : scenes()) {
+    INFO(s.name);
+    const Bvh8Tree t = build_bvh8(s.soup);
+    REQUIRE_NOTHROW(t.validate());
+    CHECK(t.left_out == s.soup.degenerate_count());
+    CHECK(t.prims.size() + t.left_out == s.soup.size());
+    CHECK(t.depth >= 2);
+  }
+  const StiffScene degenerate = make_stiff_scene("degenerate");
+  const Bvh8Tree d = build_bvh8(degenerate.soup);
+  CHECK(d.left_out >= 16);
+  CHECK_NOTHROW(d.validate());
+
+  const Bvh8Tree good = build_bvh8(load_mesh(test::scene_path("suzanne.obj")));
+  Bvh8Tree t = good;
+  t.nodes[0].box[0][0] = std::nextafter(t.nodes[0].box[0][0], 1e30f);  // child box no longer holds its triangles
+  CHECK_THROWS_AS(t.validate(), std::logic_error);
+  t = good;
+  t.nodes[0].child[0] = Bvh8Node::inner_ref(std::uint32_t(t.nodes.size()));  // out of range
+  CHECK_THROWS_AS(t.validate(), std::logic_error);
+  t = good;
+  t.prims[0] = t.prims[1];  // one triangle twice, another in no leaf
+  CHECK_THROWS_AS(t.validate(), std::logic_error);
+  CHECK_THROWS_AS(Bvh8Tracer(std::move(t)), UsageError);
+  Bvh8Config bad;
+  bad.max_leaf_size = 0;
+  CHECK_THROWS_AS(build_bvh8(make_icosphere({0, 0, 0}, 1, 1), bad), UsageError);
+  bad.max_leaf_size = 16;
+  CHECK_THROWS_AS(build_bvh8(make_icosphere({0, 0, 0}, 1, 1), bad), UsageError);
+}
+
+TEST_CASE("bvh8: exact leaves equal the exact reference, bit for bit", "[bvh8]") {
+  for (const Scene& s : scenes()) {
+    const ExactTracer exact(s.soup);
+    const auto bvh = exact_bvh8(s.soup);
+    const std::vector<Ray> rays = test_rays(s.soup, 1500);
+    INFO(s.name << ": " << rays.size() << " rays");
+    CHECK(differing(exact, *bvh, rays) == 0);
+  }
+}
+
+TEST_CASE("bvh8: float leaves equal brute force on random rays", "[bvh8]") {
+  for (const Scene& s : scenes()) {
+    const BruteForceTracer brute(s.soup);
+    const auto bvh = make_tracer("bvh8-float", s.soup);
+    const std::vector<Ray> rays = random_rays(s.soup, 3000, 5);
+    std::vector<Hit> a(rays.size()), b(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) a[i] = brute.trace(rays[i]), b[i] = bvh->trace(rays[i]);
+    const HitComparison c = compare_hits(a, b);
+    INFO(s.name << ": lost " << c.lost << ", extra " << c.extra << ", farther " << c.farther);
+    CHECK(c.agrees());
+    CHECK(c.same_triangle + c.both_miss + c.tie == rays.size());
+  }
+}
+
+TEST_CASE("bvh8: the plain x86-64 kernel equals the AVX2 kernel, hits and counters", "[bvh8]") {
+  const TriangleSoup soup = load_mesh(test::scene_path("utah-teapot.obj"));
+  Bvh8Tracer a(build_bvh8(soup)), b(build_bvh8(soup));
+  if (detected_isa() < Isa::Avx2) {
+    CHECK_THROWS_AS(b.set_kernel_isa(Isa::Avx2), UsageError);
+    return;
+  }
+  a.set_kernel_isa(Isa::Scalar);
+  b.set_kernel_isa(Isa::Avx2);
+  CHECK(a.kernel_isa() == Isa::Scalar);
+  const std::vector<Ray> rays = test_rays(soup, 1000);
+  RayCounters ca, cb;
+  std::size_t bad = 0;
+  for (const Ray& r : rays) {
+    const Hit x = a.trace(r, &ca), y = b.trace(r, &cb);
+    bad += (x.prim != y.prim || std::memcmp(&x, &y, sizeof(Hit)) != 0) ? 1 : 0;
+  }
+  CHECK(bad == 0);
+  CHECK(ca.rays == rays.size());
+  CHECK(ca.box_node_visits == cb.box_node_visits);
+  CHECK(ca.triangle_tests == cb.triangle_tests);
+  CHECK(ca.box_node_visits >= rays.size() / 2);  // invalid rays visit nothing
+}
+
+TEST_CASE("bvh8: counters, and counted hits equal uncounted ones", "[bvh8]") {
+  const TriangleSoup soup = load_mesh(test::scene_path("suzanne.obj"));
+  const auto bvh = exact_bvh8(soup);
+  const std::vector<Ray> rays = vertex_rays(soup, 2000, 3);
+  RayCounters c;
+  std::size_t bad = 0;
+  for (const Ray& r : rays) {
+    const Hit x = bvh->trace(r), y = bvh->trace(r, &c);
+    bad += std::memcmp(&x, &y, sizeof(Hit)) != 0 ? 1 : 0;
+  }
+  CHECK(bad == 0);
+  CHECK(c.rays == rays.size());
+  CHECK(c.box_node_visits >= rays.size());
+  CHECK(c.leaf_visits >= rays.size() / 2);
+  CHECK(c.triangle_tests >= c.leaf_visits);
+  CHECK(c.rule_decisions > 0);  // rays through vertices: the exact leaf test's rules decide
+}
+
+// The boxes are the triangles' exact float bounds, and the box test keeps every
+// point of the exact ray; moving each face in by one float step drops the
+// corners on the faces, where rays through vertices hit.
+TEST_CASE("bvh8: boxes shrunk by one float step lose hits on vertex rays", "[bvh8]") {
+  const TriangleSoup soup = load_mesh(test::scene_path("utah-teapot.obj"));
+  const ExactTracer exact(soup);
+  const CertifiedIntersector leaf(soup);
+  Bvh8Tracer tight(build_bvh8(soup)), shrunk(build_bvh8(soup));
+  tight.set_exact_leaf(&leaf);
+  shrunk.set_exact_leaf(&leaf);
+  shrunk.shrink_boxes_for_testing();
+  const std::vector<Ray> rays = vertex_rays(soup, 3000, 9);
+  const std::size_t bad_tight = differing(exact, tight, rays), bad_shrunk = differing(exact, shrunk, rays);
+  INFO("differing hits: tight " << bad_tight << ", shrunk " << bad_shrunk << " of " << rays.size());
+  CHECK(bad_tight == 0);
+  CHECK(bad_shrunk > 0);
+}
+
+// Beyond 2^126, p - o could overflow in float; such rays and scenes are traced
+// against every triangle, still exactly.
+TEST_CASE("bvh8: coordinates beyond 2^126 are traced exactly", "[bvh8]") {
+  const TriangleSoup far = transformed_soup(make_icosphere({0, 0, 0}, 1.0f, 2), 0x1p100f, {0x1p126f, 0, 0});
+  const ExactTracer exact(far);
+  const auto bvh = exact_bvh8(far);
+  std::vector<Ray> rays = random_rays(far, 500, 2);
+  const std::vector<Ray> v = vertex_rays(far, 500, 3);
+  rays.insert(rays.end(), v.begin(), v.end());
+  CHECK(differing(exact, *bvh, rays) == 0);
+  std::size_t hits = 0;
+  for (const Ray& r : rays) hits += bvh->trace(r).hit() ? 1 : 0;
+  CHECK(hits > rays.size() / 4);
+  // A scene near the origin and a ray from beyond 2^126 towards it.
+  const TriangleSoup near = make_icosphere({0, 0, 0}, 1.0f, 2);
+  const auto b = exact_bvh8(near);
+  const ExactTracer e(near);
+  Ray r;
+  r.org = {0x1p127f, 0.25f, 0.25f};
+  r.dir = {-1, 0, 0};
+  CHECK(b->trace(r).hit());
+  CHECK(b->trace(r).prim == e.trace(r).prim);
+}

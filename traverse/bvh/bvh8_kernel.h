@@ -1,0 +1,62 @@
+#pragma once
+/// \file bvh8_kernel.h
+/// Internal to the BVH8 tracer: the raw view of a tree that the per-ISA
+/// single-ray kernels (bvh8_kernel.inl) read, the per-ray constants they
+/// share, and their entry points.
+
+#include <bit>
+#include <cstdint>
+
+#include "bsprt/ray.h"
+#include "traverse/bvh/bvh8_node.h"
+#include "traverse/counters.h"
+#include "traverse/leaf_intersector.h"
+
+namespace bsprt::detail {
+
+/// Raw pointers into a Bvh8Tracer.
+struct Bvh8View {
+  const Bvh8Node* nodes;
+  const std::uint32_t* prims;
+  const LeafTriangle* triangles;           ///< corners of prims[i]
+  const LeafIntersector* exact_leaf;       ///< exact-decision leaf test, or null = float watertight
+};
+
+/// Traversal stack entries: at most 7 per level of inner nodes, plus one.
+inline constexpr std::uint32_t kBvh8MaxDepth = 64;
+inline constexpr int kBvh8StackSize = 7 * int(kBvh8MaxDepth) + 1;
+
+/// Per-ray reciprocals of the conservative box test (docs/bvh8.md): for every
+/// axis, rn and rf bracket 1/d with |rn| <= 1 / (|d| (1 + 2^-24)) and
+/// |rf| >= 1 / (|d| (1 - 2^-24)), with the sign of d; for d = +-0 both are
+/// the infinity of d's sign.
+struct Bvh8RayRecip {
+  float rn[3], rf[3];
+};
+
+/// r = fl(1/d) is within 2^-24 |1/d| of 1/d (IEEE division), so the bounds
+/// need |r| (1 -+ 2^-24)^(+-2), a little more than 2^-23 relative: three float
+/// steps of |r| (each at least 2^-24 |r| for normal |r|, more for subnormal)
+/// give rf, three steps down give rn. An infinite r (d = 0, or |d| so small
+/// that 1/d overflows) stays infinite in rf; rn is infinite only for d = 0.
+inline Bvh8RayRecip bvh8_reciprocals(const Ray& ray) {
+  Bvh8RayRecip r;
+  for (int k = 0; k < 3; ++k) {
+    const float d = ray.dir[k];
+    const float q = 1.0f / d;
+    const std::uint32_t sign = std::bit_cast<std::uint32_t>(q) & 0x80000000u;
+    const std::uint32_t mag = std::bit_cast<std::uint32_t>(q) & 0x7fffffffu;  // at least 1/FLT_MAX's bits
+    const std::uint32_t up = mag >= 0x7f7ffffdu ? 0x7f800000u : mag + 3u;
+    const std::uint32_t down = d == 0.0f ? mag : mag - 3u;
+    r.rn[k] = std::bit_cast<float>(sign | down);
+    r.rf[k] = std::bit_cast<float>(sign | up);
+  }
+  return r;
+}
+
+/// Nearest hit of one ray; counts into c when non-null. Call the AVX2 one only
+/// when detected_isa() >= Avx2; the base one (plain x86-64) runs anywhere.
+Hit bvh8_trace_avx2(const Bvh8View& view, const Ray& ray, RayCounters* c);
+Hit bvh8_trace_base(const Bvh8View& view, const Ray& ray, RayCounters* c);
+
+}  // namespace bsprt::detail

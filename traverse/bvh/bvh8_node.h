@@ -1,0 +1,72 @@
+#pragma once
+/// \file bvh8_node.h
+/// A plain 8-wide bounding-volume hierarchy over triangles (issue #26, step
+/// one): the box kernel of bvh8_kernel.inl on the same kind of tree Embree
+/// traces, so the kernel can be compared with Embree's apart from the tree.
+///
+/// Node layout (224 bytes, 32-byte aligned; Embree's AABBNode8 idea with
+/// 32-bit references): six rows of eight floats, lo_x hi_x lo_y hi_y lo_z
+/// hi_z, then eight child references. A ray picks its near and far row per
+/// axis once from the signs of its direction (bvh8_kernel.inl), so no node
+/// test branches on the direction. An unused slot has the empty box
+/// (lo = +inf, hi = -inf), which no ray enters, and reference 0.
+///
+/// Child reference (32 bits): the low 4 bits are 0 for an inner node, whose
+/// index is ref >> 4, or the number of triangles (1..15) of a leaf, whose first
+/// entry in the leaf lists is ref >> 4. Node 0 is the root and never a child,
+/// so reference 0 in a slot means "empty".
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "bsprt/vec3.h"
+#include "traverse/leaf_intersector.h"
+
+namespace bsprt {
+
+/// One node: boxes of up to eight children (SoA rows) and their references.
+struct alignas(32) Bvh8Node {
+  /// box[2k][i] = lower bound on axis k of child i, box[2k + 1][i] = upper bound.
+  float box[6][8];
+  std::uint32_t child[8];  ///< references (see the file comment); 0 = empty slot
+
+  static constexpr std::uint32_t kLeafMask = 0xfu;
+  static constexpr std::uint32_t kMaxLeafSize = 15;
+  static bool is_leaf(std::uint32_t ref) { return (ref & kLeafMask) != 0; }
+  static std::uint32_t index(std::uint32_t ref) { return ref >> 4; }
+  static std::uint32_t count(std::uint32_t ref) { return ref & kLeafMask; }
+  static std::uint32_t inner_ref(std::uint32_t node) { return node << 4; }
+  static std::uint32_t leaf_ref(std::uint32_t first, std::uint32_t n) { return (first << 4) | n; }
+  /// A node whose eight slots are empty.
+  static Bvh8Node empty();
+  /// Sets slot i to `ref` with box b.
+  void set(int i, std::uint32_t ref, const Box3f& b);
+  /// Box of slot i.
+  Box3f child_box(int i) const;
+};
+static_assert(sizeof(Bvh8Node) == 224, "Bvh8Node: 6 x 8 floats + 8 references");
+static_assert(alignof(Bvh8Node) == 32, "Bvh8Node rows are loaded as aligned 32-byte vectors");
+
+/// The tree: nodes (0 = root, always an inner node), and the leaf lists, in
+/// leaf order: triangle numbers and their corners.
+struct Bvh8Tree {
+  std::vector<Bvh8Node> nodes;
+  std::vector<std::uint32_t> prims;
+  std::vector<LeafTriangle> triangles;  ///< corners of prims[i] at triangles[i]
+  std::uint32_t depth = 0;              ///< levels of inner nodes (root = 1)
+  std::uint32_t scene_triangles = 0;    ///< triangles of the scene it was built for
+  std::uint32_t left_out = 0;           ///< degenerate (or non-finite) triangles, in no leaf: no mode hits them
+
+  /// Checks the invariants; throws std::logic_error naming the broken one:
+  /// references in range, every node reached once, each child's box holds
+  /// its subtree's boxes and a leaf's box its triangles' corners, every
+  /// triangle in at most one leaf and exactly `left_out` in none.
+  void validate() const;
+  std::size_t memory_bytes() const {
+    return nodes.size() * sizeof(Bvh8Node) + prims.size() * sizeof(std::uint32_t) +
+           triangles.size() * sizeof(LeafTriangle);
+  }
+};
+
+}  // namespace bsprt

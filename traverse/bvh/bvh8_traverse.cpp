@@ -1,0 +1,79 @@
+/// \file bvh8_traverse.cpp
+/// Bvh8Tracer and its fallback for coordinates so large that p - o could overflow.
+#include "traverse/bvh/bvh8_traverse.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "bsprt/error.h"
+#include "traverse/bvh/bvh8_kernel.h"
+#include "traverse/watertight.h"
+
+namespace bsprt {
+
+namespace {
+
+constexpr float kHuge = 0x1p126f;
+
+float max_abs(const Vec3f& p) { return std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}); }
+
+}  // namespace
+
+Bvh8Tracer::Bvh8Tracer(Bvh8Tree tree) : tree_(std::move(tree)) {
+  try {
+    tree_.validate();
+  } catch (const std::logic_error& e) {
+    throw UsageError(std::string("bvh8 tree is not valid: ") + e.what());
+  }
+  if (tree_.depth > detail::kBvh8MaxDepth)
+    throw UsageError("bvh8 tree deeper than " + std::to_string(detail::kBvh8MaxDepth) + " levels");
+  for (const LeafTriangle& t : tree_.triangles)
+    for (const Vec3f& p : t.v) huge_scene_ = huge_scene_ || !(max_abs(p) <= kHuge);
+  isa_ = detected_isa() >= Isa::Avx2 ? Isa::Avx2 : Isa::Scalar;
+}
+
+void Bvh8Tracer::set_kernel_isa(Isa isa) {
+  if (isa == Isa::Avx2 && detected_isa() < Isa::Avx2) throw UsageError("bvh8: this CPU has no AVX2");
+  isa_ = isa == Isa::Avx2 ? Isa::Avx2 : Isa::Scalar;
+}
+
+void Bvh8Tracer::shrink_boxes_for_testing() {
+  const float inf = std::numeric_limits<float>::infinity();
+  for (Bvh8Node& n : tree_.nodes)
+    for (int i = 0; i < 8; ++i) {
+      if (n.child[i] == 0) continue;
+      for (int k = 0; k < 3; ++k) {
+        n.box[2 * k][i] = std::nextafter(n.box[2 * k][i], inf);
+        n.box[2 * k + 1][i] = std::nextafter(n.box[2 * k + 1][i], -inf);
+      }
+    }
+}
+
+Hit Bvh8Tracer::trace_every_triangle(const Ray& ray, RayCounters* counters) const {
+  if (exact_leaf_) {
+    NearestHit best;
+    exact_leaf_->intersect(ray, tree_.prims, tree_.triangles.data(), best, counters);
+    return best.hit;
+  }
+  Hit hit;
+  const WatertightRay wr = watertight_precompute(ray);
+  if (counters) counters->triangle_tests += tree_.prims.size();
+  for (std::size_t i = 0; i < tree_.prims.size(); ++i) {
+    const LeafTriangle& t = tree_.triangles[i];
+    intersect_watertight_closest(wr, t.v[0], t.v[1], t.v[2], tree_.prims[i], hit);
+  }
+  return hit;
+}
+
+Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
+  if (huge_scene_ || !(max_abs(ray.org) <= kHuge)) {
+    if (counters) ++counters->rays;
+    return is_valid(ray) ? trace_every_triangle(ray, counters) : Hit{};
+  }
+  const detail::Bvh8View v{tree_.nodes.data(), tree_.prims.data(), tree_.triangles.data(), exact_leaf_};
+  return isa_ == Isa::Avx2 ? detail::bvh8_trace_avx2(v, ray, counters) : detail::bvh8_trace_base(v, ray, counters);
+}
+
+}  // namespace bsprt

@@ -1,0 +1,26 @@
+#pragma once
+/// \file bvh8_build.h
+/// Building the plain BVH8 of traverse/bvh/bvh8_node.h with Embree's SAH
+/// builder (rtcBuildBVH): Embree chooses the splits, our callbacks record
+/// them, and the boxes are then recomputed from the triangles' float corners
+/// (exact min/max), so the tree's certificate does not rest on Embree.
+
+#include "geometry/core/triangle_soup.h"
+#include "traverse/bvh/bvh8_node.h"
+
+namespace bsprt {
+
+/// Build settings; the defaults are Embree's own for its BVH8 of triangles.
+struct Bvh8Config {
+  unsigned max_leaf_size = 4;    ///< triangles per leaf at most (1..15)
+  float traversal_cost = 1.0f;   ///< SAH cost of a node step
+  float intersection_cost = 1.0f;  ///< SAH cost of a triangle test
+};
+
+/// Builds the BVH8 over the triangles of `soup`; degenerate triangles and
+/// triangles with non-finite corners are left out (counted in left_out: no
+/// mode hits them). Throws UsageError for a bad config, std::runtime_error
+/// when Embree fails.
+Bvh8Tree build_bvh8(const TriangleSoup& soup, const Bvh8Config& config = {});
+
+}  // namespace bsprt
