@@ -15,7 +15,7 @@ ROOT=$(pwd)
 SCENE=${1:-$ROOT/../shared/scenes/stanford-bunny.obj}
 N=${2:-100000}
 BUILD=${BSPRT_BUILD_DIR:-build}
-MODES=${MODES:-"kd bsp bsp:sequential bsp-top embree"}
+MODES=${MODES:-"kd bsp bsp:sequential bsp-top bvh8-float bvh8 embree"}
 RAYSETS=${RAYSETS:-"primary random"}
 
 [ -n "${BSPRT_SKIP_DEPS:-}" ] || scripts/install-deps.sh

@@ -1,8 +1,9 @@
 // The plain BVH8 and its Embree-style single-ray kernel (issue #26, step one;
 // traverse/bvh/, docs/bvh8.md): the tree checks itself; with exact leaves the
 // hits equal the exact reference bit for bit on random, vertex, edge and
-// stiff rays, lines (tnear < 0) and short segments; with float leaves they
-// equal brute force; the plain x86-64 kernel equals the AVX2 one; and boxes
+// stiff rays, lines (tnear < 0) and short segments; with float leaves (the
+// four-lane block test) they equal brute force's scalar test, bit for bit on
+// the same triangle; the plain x86-64, AVX2 and AVX-512 kernels agree; and boxes
 // shrunk by one float step lose hits, so the tight boxes and the conservative
 // box test are what keeps them.
 #include <catch2/catch.hpp>
@@ -134,34 +135,47 @@ TEST_CASE("bvh8: float leaves equal brute force on random rays", "[bvh8]") {
     std::vector<Hit> a(rays.size()), b(rays.size());
     for (std::size_t i = 0; i < rays.size(); ++i) a[i] = brute.trace(rays[i]), b[i] = bvh->trace(rays[i]);
     const HitComparison c = compare_hits(a, b);
+    // The four-lane leaf test reproduces the scalar watertight test bit for bit.
+    std::size_t same_prim_other_bits = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if (a[i].prim == b[i].prim && std::memcmp(&a[i], &b[i], sizeof(Hit)) != 0) ++same_prim_other_bits;
     INFO(s.name << ": lost " << c.lost << ", extra " << c.extra << ", farther " << c.farther);
     CHECK(c.agrees());
     CHECK(c.same_triangle + c.both_miss + c.tie == rays.size());
+    CHECK(c.same_triangle > rays.size() / 10);
+    CHECK(same_prim_other_bits == 0);
   }
 }
 
-TEST_CASE("bvh8: the plain x86-64 kernel equals the AVX2 kernel, hits and counters", "[bvh8]") {
+TEST_CASE("bvh8: the plain x86-64, AVX2 and AVX-512 kernels agree bit for bit, hits and counters", "[bvh8]") {
   const TriangleSoup soup = load_mesh(test::scene_path("utah-teapot.obj"));
-  Bvh8Tracer a(build_bvh8(soup)), b(build_bvh8(soup));
-  if (detected_isa() < Isa::Avx2) {
-    CHECK_THROWS_AS(b.set_kernel_isa(Isa::Avx2), UsageError);
-    return;
-  }
-  a.set_kernel_isa(Isa::Scalar);
-  b.set_kernel_isa(Isa::Avx2);
-  CHECK(a.kernel_isa() == Isa::Scalar);
+  Bvh8Tracer base(build_bvh8(soup)), wide(build_bvh8(soup));
+  base.set_kernel_isa(Isa::Scalar);
+  CHECK(base.kernel_isa() == Isa::Scalar);
   const std::vector<Ray> rays = test_rays(soup, 1000);
-  RayCounters ca, cb;
-  std::size_t bad = 0;
-  for (const Ray& r : rays) {
-    const Hit x = a.trace(r, &ca), y = b.trace(r, &cb);
-    bad += (x.prim != y.prim || std::memcmp(&x, &y, sizeof(Hit)) != 0) ? 1 : 0;
+  std::vector<Hit> ref(rays.size());
+  RayCounters cr;
+  for (std::size_t i = 0; i < rays.size(); ++i) ref[i] = base.trace(rays[i], &cr);
+  CHECK(cr.rays == rays.size());
+  CHECK(cr.box_node_visits >= rays.size() / 2);  // invalid rays visit nothing
+  for (const Isa isa : {Isa::Avx2, Isa::Avx512}) {
+    if (int(detected_isa()) < int(isa)) {
+      CHECK_THROWS_AS(wide.set_kernel_isa(isa), UsageError);
+      continue;
+    }
+    wide.set_kernel_isa(isa);
+    RayCounters cw;
+    std::size_t bad = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const Hit h = wide.trace(rays[i], &cw);
+      bad += std::memcmp(&h, &ref[i], sizeof(Hit)) != 0 ? 1 : 0;
+    }
+    INFO(isa_name(isa));
+    CHECK(bad == 0);
+    CHECK(cw.box_node_visits == cr.box_node_visits);
+    CHECK(cw.leaf_visits == cr.leaf_visits);
+    CHECK(cw.triangle_tests == cr.triangle_tests);
   }
-  CHECK(bad == 0);
-  CHECK(ca.rays == rays.size());
-  CHECK(ca.box_node_visits == cb.box_node_visits);
-  CHECK(ca.triangle_tests == cb.triangle_tests);
-  CHECK(ca.box_node_visits >= rays.size() / 2);  // invalid rays visit nothing
 }
 
 TEST_CASE("bvh8: counters, and counted hits equal uncounted ones", "[bvh8]") {

@@ -17,9 +17,10 @@ namespace bsprt::detail {
 /// Raw pointers into a Bvh8Tracer.
 struct Bvh8View {
   const Bvh8Node* nodes;
+  const float* leaf_soa;               ///< SoA rows of the leaf entries (the float test)
   const std::uint32_t* prims;
-  const LeafTriangle* triangles;           ///< corners of prims[i]
-  const LeafIntersector* exact_leaf;       ///< exact-decision leaf test, or null = float watertight
+  const LeafTriangle* triangles;       ///< corners of prims[i]
+  const LeafIntersector* exact_leaf;   ///< exact-decision leaf test, or null = float watertight
 };
 
 /// Traversal stack entries: at most 7 per level of inner nodes, plus one.
@@ -54,8 +55,10 @@ inline Bvh8RayRecip bvh8_reciprocals(const Ray& ray) {
   return r;
 }
 
-/// Nearest hit of one ray; counts into c when non-null. Call the AVX2 one only
-/// when detected_isa() >= Avx2; the base one (plain x86-64) runs anywhere.
+/// Nearest hit of one ray; counts into c when non-null. Call the AVX2 and
+/// AVX-512 ones only when detected_isa() supports them; the base one (plain
+/// x86-64) runs anywhere. All three return the same hits, bit for bit.
+Hit bvh8_trace_avx512(const Bvh8View& view, const Ray& ray, RayCounters* c);
 Hit bvh8_trace_avx2(const Bvh8View& view, const Ray& ray, RayCounters* c);
 Hit bvh8_trace_base(const Bvh8View& view, const Ray& ray, RayCounters* c);
 

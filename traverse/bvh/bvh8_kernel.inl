@@ -90,13 +90,104 @@ inline std::uint32_t key(float d, unsigned slot) {
   return (b & ~7u) | slot;
 }
 
-inline void prefetch_node(const Bvh8View& v, std::uint32_t ref) {
-  if (Bvh8Node::is_leaf(ref)) return;
+/// Prefetches what a reference points to: a node's four lines, or a leaf's
+/// first corners (Embree prefetches every hit child the same way).
+inline void prefetch_ref(const Bvh8View& v, std::uint32_t ref) {
+  if (Bvh8Node::is_leaf(ref)) {
+    const char* p = reinterpret_cast<const char*>(v.leaf_soa + 9 * std::size_t(Bvh8Node::index(ref)));
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + 64);
+    if (Bvh8Node::count(ref) > 1) __builtin_prefetch(p + 128);
+    return;
+  }
   const char* p = reinterpret_cast<const char*>(&v.nodes[Bvh8Node::index(ref)]);
   __builtin_prefetch(p);
   __builtin_prefetch(p + 64);
   __builtin_prefetch(p + 128);
   __builtin_prefetch(p + 192);
+}
+
+/// Orders a, b so that a >= b, without a branch.
+[[gnu::always_inline]] inline void sort_pair_desc(std::uint32_t& a, std::uint32_t& b) {
+  const std::uint32_t hi = a > b ? a : b, lo = a > b ? b : a;
+  a = hi, b = lo;
+}
+
+/// Sorts keys[0..n) descending: networks for 3 and 4 (the common cases),
+/// insertion sort beyond.
+inline void sort_keys_desc(std::uint32_t* k, int n) {
+  if (n == 3) {
+    sort_pair_desc(k[0], k[1]);
+    sort_pair_desc(k[1], k[2]);
+    sort_pair_desc(k[0], k[1]);
+    return;
+  }
+  if (n == 4) {
+    sort_pair_desc(k[0], k[1]);
+    sort_pair_desc(k[2], k[3]);
+    sort_pair_desc(k[0], k[2]);
+    sort_pair_desc(k[1], k[3]);
+    sort_pair_desc(k[1], k[2]);
+    return;
+  }
+  for (int i = 1; i < n; ++i) {
+    const std::uint32_t x = k[i];
+    int j = i;
+    for (; j > 0 && k[j - 1] < x; --j) k[j] = k[j - 1];
+    k[j] = x;
+  }
+}
+
+/// The watertight test (watertight.h) of one ray against the `count` (1..4)
+/// triangles of a leaf at once, SoA rows at `rows` (bvh8_node.h), triangle
+/// numbers at `prims`: lane by lane the same IEEE operations in the same
+/// order, lanes with an exactly zero edge function redone by the same double
+/// fallback, so the result is the scalar leaf loop's bit for bit: the
+/// smallest t in [tnear, tfar] below hit.t, the earliest lane among equal t.
+inline void intersect_leaf(const WatertightRay& r, const float* rows, const std::uint32_t* prims,
+                           std::uint32_t count, Hit& hit) {
+  using V4 = simd::vfloat<4>;
+  using M4 = simd::vmask<4>;
+  const auto lane = [&](int c, int k) { return simd::load<4>(rows + (3 * c + k) * count); };
+  V4 rel[3][3];  // corner c minus the origin, axis k
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 3; ++k) rel[c][k] = lane(c, k) - r.org[k];
+  const V4 sx = simd::splat<4>(r.sx), sy = simd::splat<4>(r.sy), sz = simd::splat<4>(r.sz);
+  const V4 az = rel[0][r.kz], bz = rel[1][r.kz], cz = rel[2][r.kz];
+  const V4 ax = rel[0][r.kx] - no_fma(sx * az), ay = rel[0][r.ky] - no_fma(sy * az);
+  const V4 bx = rel[1][r.kx] - no_fma(sx * bz), by = rel[1][r.ky] - no_fma(sy * bz);
+  const V4 cx = rel[2][r.kx] - no_fma(sx * cz), cy = rel[2][r.ky] - no_fma(sy * cz);
+  V4 u = no_fma(cx * by) - no_fma(cy * bx);
+  V4 v = no_fma(ax * cy) - no_fma(ay * cx);
+  V4 w = no_fma(bx * ay) - no_fma(by * ax);
+  const M4 live = simd::VecTypes<4>::I{0, 1, 2, 3} < std::int32_t(count);
+  const M4 zero = ((u == 0.0f) | (v == 0.0f) | (w == 0.0f)) & live;
+  if (simd::any<4>(zero)) {
+    for (int i = 0; i < 4; ++i) {
+      if (!zero[i]) continue;
+      float ui, vi, wi;
+      watertight_edges_double(ax[i], ay[i], bx[i], by[i], cx[i], cy[i], ui, vi, wi);
+      u[i] = ui, v[i] = vi, w[i] = wi;
+    }
+  }
+  const M4 neg = (u < 0.0f) | (v < 0.0f) | (w < 0.0f), pos = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
+  const V4 det = u + v + w;
+  const V4 tz = no_fma(u * (sz * az)) + no_fma(v * (sz * bz)) + no_fma(w * (sz * cz));
+  const V4 t = tz / det;
+  const M4 ok = live & ~(neg & pos) & (det != 0.0f) & (t >= r.tnear) & (t <= r.tfar) &
+                (t < std::numeric_limits<float>::infinity()) & (t < hit.t);
+  unsigned m = simd::movemask<4>(ok);
+  if (m == 0) return;
+  int best = __builtin_ctz(m);
+  for (m &= m - 1; m; m &= m - 1) {
+    const int i = __builtin_ctz(m);
+    if (t[i] < t[best]) best = i;
+  }
+  const float rcp = 1.0f / det[best];
+  hit.t = t[best];
+  hit.prim = prims[best];
+  hit.u = v[best] * rcp;
+  hit.v = w[best] * rcp;
 }
 
 template <bool kCount, bool kLine>
@@ -137,6 +228,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       m &= m - 1;
       if (m == 0) {
         ref = n.child[s0];
+        prefetch_ref(v, ref);
         continue;
       }
       const unsigned s1 = unsigned(__builtin_ctz(m));
@@ -144,9 +236,10 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       if (m == 0) {
         const bool first = dist[s0] <= dist[s1];
         const unsigned nearer = first ? s0 : s1, farther = first ? s1 : s0;
+        prefetch_ref(v, n.child[s0]);
+        prefetch_ref(v, n.child[s1]);
         stack[sp++] = {n.child[farther], dist[farther]};
         ref = n.child[nearer];
-        prefetch_node(v, ref);
         continue;
       }
       std::uint32_t keys[8];
@@ -158,18 +251,14 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
         m &= m - 1;
         keys[count++] = key(dist[s], s);
       }
-      for (int i = 1; i < count; ++i) {  // insertion sort, descending: at most 8 keys
-        const std::uint32_t x = keys[i];
-        int j = i;
-        for (; j > 0 && keys[j - 1] < x; --j) keys[j] = keys[j - 1];
-        keys[j] = x;
-      }
+      sort_keys_desc(keys, count);
       for (int i = 0; i + 1 < count; ++i) {
         const unsigned s = keys[i] & 7u;
+        prefetch_ref(v, n.child[s]);
         stack[sp++] = {n.child[s], dist[s]};
       }
       ref = n.child[keys[count - 1] & 7u];
-      prefetch_node(v, ref);
+      prefetch_ref(v, ref);
     }
     {  // a leaf
       const std::uint32_t first = Bvh8Node::index(ref), count = Bvh8Node::count(ref);
@@ -182,10 +271,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       } else {
         if constexpr (kCount) c->triangle_tests += count;
         if (!sheared) wr = watertight_precompute(ray), sheared = true;
-        for (std::uint32_t i = first; i < first + count; ++i) {
-          const LeafTriangle& t = v.triangles[i];
-          intersect_watertight_closest(wr, t.v[0], t.v[1], t.v[2], v.prims[i], hit);
-        }
+        intersect_leaf(wr, v.leaf_soa + 9 * std::size_t(first), v.prims + first, count, hit);
         tfar = hit.t < tfar ? hit.t : tfar;
       }
     }

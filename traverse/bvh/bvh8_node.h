@@ -12,9 +12,16 @@
 /// (lo = +inf, hi = -inf), which no ray enters, and reference 0.
 ///
 /// Child reference (32 bits): the low 4 bits are 0 for an inner node, whose
-/// index is ref >> 4, or the number of triangles (1..15) of a leaf, whose first
-/// entry in the leaf lists is ref >> 4. Node 0 is the root and never a child,
-/// so reference 0 in a slot means "empty".
+/// index is ref >> 4, or the number n of triangles (1..4) of a leaf, whose
+/// first entry in the leaf lists is ref >> 4. Node 0 is the root and never a
+/// child, so reference 0 in a slot means "empty".
+///
+/// A leaf's triangles are stored twice. For the float kernel, which tests
+/// them at once in four lanes (as Embree tests its Triangle4 leaves), in SoA
+/// form without padding: nine rows of n floats (corner c, axis k at row
+/// 3c + k) from leaf_soa[9 first]; a row is loaded as four floats, lanes past
+/// n masked off (leaf_soa ends with three spare floats). For the exact leaf
+/// test's interface, as lists in leaf order: prims and triangles from first.
 
 #include <cstdint>
 #include <span>
@@ -32,7 +39,7 @@ struct alignas(32) Bvh8Node {
   std::uint32_t child[8];  ///< references (see the file comment); 0 = empty slot
 
   static constexpr std::uint32_t kLeafMask = 0xfu;
-  static constexpr std::uint32_t kMaxLeafSize = 15;
+  static constexpr std::uint32_t kMaxLeafSize = 4;
   static bool is_leaf(std::uint32_t ref) { return (ref & kLeafMask) != 0; }
   static std::uint32_t index(std::uint32_t ref) { return ref >> 4; }
   static std::uint32_t count(std::uint32_t ref) { return ref & kLeafMask; }
@@ -48,10 +55,11 @@ struct alignas(32) Bvh8Node {
 static_assert(sizeof(Bvh8Node) == 224, "Bvh8Node: 6 x 8 floats + 8 references");
 static_assert(alignof(Bvh8Node) == 32, "Bvh8Node rows are loaded as aligned 32-byte vectors");
 
-/// The tree: nodes (0 = root, always an inner node), and the leaf lists, in
-/// leaf order: triangle numbers and their corners.
+/// The tree: nodes (0 = root, always an inner node), and the leaf lists in
+/// leaf order: corners in SoA rows, triangle numbers, corners as triangles.
 struct Bvh8Tree {
   std::vector<Bvh8Node> nodes;
+  std::vector<float> leaf_soa;  ///< 9 floats per leaf entry (see the file comment), then 3 spare
   std::vector<std::uint32_t> prims;
   std::vector<LeafTriangle> triangles;  ///< corners of prims[i] at triangles[i]
   std::uint32_t depth = 0;              ///< levels of inner nodes (root = 1)
@@ -60,12 +68,13 @@ struct Bvh8Tree {
 
   /// Checks the invariants; throws std::logic_error naming the broken one:
   /// references in range, every node reached once, each child's box holds
-  /// its subtree's boxes and a leaf's box its triangles' corners, every
-  /// triangle in at most one leaf and exactly `left_out` in none.
+  /// its subtree's boxes and a leaf's box its triangles' corners, SoA rows
+  /// equal to the lists, every triangle in at most one leaf and exactly
+  /// `left_out` in none.
   void validate() const;
   std::size_t memory_bytes() const {
-    return nodes.size() * sizeof(Bvh8Node) + prims.size() * sizeof(std::uint32_t) +
-           triangles.size() * sizeof(LeafTriangle);
+    return nodes.size() * sizeof(Bvh8Node) + leaf_soa.size() * sizeof(float) +
+           prims.size() * sizeof(std::uint32_t) + triangles.size() * sizeof(LeafTriangle);
   }
 };
 

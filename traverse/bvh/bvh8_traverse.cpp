@@ -31,19 +31,19 @@ Bvh8Tracer::Bvh8Tracer(Bvh8Tree tree) : tree_(std::move(tree)) {
     throw UsageError("bvh8 tree deeper than " + std::to_string(detail::kBvh8MaxDepth) + " levels");
   for (const LeafTriangle& t : tree_.triangles)
     for (const Vec3f& p : t.v) huge_scene_ = huge_scene_ || !(max_abs(p) <= kHuge);
-  isa_ = detected_isa() >= Isa::Avx2 ? Isa::Avx2 : Isa::Scalar;
+  isa_ = detected_isa() >= Isa::Avx2 ? detected_isa() : Isa::Scalar;
 }
 
 void Bvh8Tracer::set_kernel_isa(Isa isa) {
-  if (isa == Isa::Avx2 && detected_isa() < Isa::Avx2) throw UsageError("bvh8: this CPU has no AVX2");
-  isa_ = isa == Isa::Avx2 ? Isa::Avx2 : Isa::Scalar;
+  if (int(isa) > int(detected_isa())) throw UsageError("bvh8: this CPU has no " + isa_name(isa));
+  isa_ = isa == Isa::Sse42 ? Isa::Scalar : isa;
 }
 
 void Bvh8Tracer::shrink_boxes_for_testing() {
   const float inf = std::numeric_limits<float>::infinity();
   for (Bvh8Node& n : tree_.nodes)
     for (int i = 0; i < 8; ++i) {
-      if (n.child[i] == 0) continue;
+      if (n.child[i] == 0) continue;  // keep empty slots empty
       for (int k = 0; k < 3; ++k) {
         n.box[2 * k][i] = std::nextafter(n.box[2 * k][i], inf);
         n.box[2 * k + 1][i] = std::nextafter(n.box[2 * k + 1][i], -inf);
@@ -72,8 +72,16 @@ Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
     if (counters) ++counters->rays;
     return is_valid(ray) ? trace_every_triangle(ray, counters) : Hit{};
   }
-  const detail::Bvh8View v{tree_.nodes.data(), tree_.prims.data(), tree_.triangles.data(), exact_leaf_};
-  return isa_ == Isa::Avx2 ? detail::bvh8_trace_avx2(v, ray, counters) : detail::bvh8_trace_base(v, ray, counters);
+  const detail::Bvh8View v{tree_.nodes.data(), tree_.leaf_soa.data(), tree_.prims.data(), tree_.triangles.data(),
+                           exact_leaf_};
+  switch (isa_) {
+    case Isa::Avx512:
+      return detail::bvh8_trace_avx512(v, ray, counters);
+    case Isa::Avx2:
+      return detail::bvh8_trace_avx2(v, ray, counters);
+    default:
+      return detail::bvh8_trace_base(v, ray, counters);
+  }
 }
 
 }  // namespace bsprt

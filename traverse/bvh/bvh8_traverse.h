@@ -1,8 +1,8 @@
 #pragma once
 /// \file bvh8_traverse.h
 /// Single rays through a plain BVH8 (bvh8_node.h) with the Embree-style box
-/// kernel of bvh8_kernel.inl (AVX2 when the CPU has it, else the same source
-/// for plain x86-64). The box test is conservative (docs/bvh8.md): no hit of
+/// kernel of bvh8_kernel.inl (AVX-512 or AVX2 when the CPU has it, else the
+/// same source for plain x86-64). The box test is conservative (docs/bvh8.md): no hit of
 /// the exact ray is lost, so with an exact leaf test the nearest hit equals
 /// the exact reference's; with the float watertight test it equals brute
 /// force's up to ties.
@@ -36,10 +36,10 @@ class Bvh8Tracer final : public Accelerator {
   std::size_t memory_bytes() const override { return tree_.memory_bytes(); }
 
   const Bvh8Tree& tree() const { return tree_; }
-  /// The kernel's ISA: Avx2 (when the CPU has it) or Scalar (plain x86-64).
+  /// The kernel's ISA: Avx512 or Avx2 (the widest the CPU has) or Scalar (plain x86-64).
   Isa kernel_isa() const { return isa_; }
-  /// Uses the plain x86-64 kernel (Isa::Scalar) or the AVX2 one (UsageError
-  /// when the CPU lacks it); tests compare the two.
+  /// Uses the plain x86-64 kernel (Isa::Scalar or Sse42), the AVX2 or the
+  /// AVX-512 one (UsageError when the CPU lacks it); tests compare them.
   void set_kernel_isa(Isa isa);
   /// Test hook: moves every box face inward by one float step, so that the
   /// tests can show that the tight boxes are needed (hits then go missing).

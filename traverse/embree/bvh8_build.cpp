@@ -17,7 +17,8 @@ namespace bsprt {
 namespace {
 
 /// Embree's depth limit for the build; a leaf it makes there may hold more
-/// than max_leaf_size triangles, which Flattener splits into 8-wide levels.
+/// than max_leaf_size triangles, which Flattener splits into 8-wide levels
+/// of leaves of at most four.
 constexpr unsigned kMaxDepth = 48;
 
 /// Embree-allocated build node: inner (up to 8 children) or leaf (triangles).
@@ -54,15 +55,20 @@ struct Flattener {
 
   [[noreturn]] static void fail(const std::string& what) { throw std::runtime_error("embree: rtcBuildBVH " + what); }
 
-  /// Appends the triangles prims[0..n) as one leaf list; returns its reference and box.
+  /// Appends the triangles prims[0..n) (n <= 4) as one leaf; returns its reference and box.
   std::uint32_t leaf(const std::uint32_t* prims, std::uint32_t n, Box3f& box) {
     const auto first = std::uint32_t(tree.prims.size());
+    const std::size_t rows = tree.leaf_soa.size();
+    tree.leaf_soa.resize(rows + 9 * std::size_t(n));
     box = Box3f{};
     for (std::uint32_t i = 0; i < n; ++i) {
       const auto c = soup.corners(prims[i]);
       tree.prims.push_back(prims[i]);
       tree.triangles.push_back({{c[0], c[1], c[2]}});
-      for (const Vec3f& p : c) box.extend(p);
+      for (int j = 0; j < 3; ++j) {
+        box.extend(c[j]);
+        for (int k = 0; k < 3; ++k) tree.leaf_soa[rows + (3 * j + k) * n + i] = c[j][k];
+      }
     }
     return Bvh8Node::leaf_ref(first, n);
   }
@@ -138,7 +144,10 @@ Bvh8Tree build_bvh8(const TriangleSoup& soup, const Bvh8Config& config) {
   f.tree.left_out = left_out;
   f.tree.nodes.push_back(Bvh8Node::empty());  // the root, filled below
   f.tree.depth = 1;
-  if (prims.empty()) return std::move(f.tree);
+  if (prims.empty()) {
+    f.tree.leaf_soa.assign(3, 0.0f);
+    return std::move(f.tree);
+  }
 
   const std::size_t count = prims.size();
   prims.resize(count * 2);  // Embree's builder may use spare capacity
@@ -179,6 +188,7 @@ Bvh8Tree build_bvh8(const TriangleSoup& soup, const Bvh8Config& config) {
       }
     }
     f.tree.nodes[0] = top;
+    f.tree.leaf_soa.insert(f.tree.leaf_soa.end(), 3, 0.0f);  // a row's four-float load may read past the last
   } catch (...) {
     rtcReleaseBVH(bvh);
     throw;

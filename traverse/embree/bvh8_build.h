@@ -12,9 +12,9 @@ namespace bsprt {
 
 /// Build settings; the defaults are Embree's own for its BVH8 of triangles.
 struct Bvh8Config {
-  unsigned max_leaf_size = 4;    ///< triangles per leaf at most (1..15)
+  unsigned max_leaf_size = 4;    ///< triangles per leaf at most (1..4: one four-lane block)
   float traversal_cost = 1.0f;   ///< SAH cost of a node step
-  float intersection_cost = 1.0f;  ///< SAH cost of a triangle test
+  float intersection_cost = 0.1f;  ///< SAH cost of a triangle test
 };
 
 /// Builds the BVH8 over the triangles of `soup`; degenerate triangles and
