@@ -22,21 +22,27 @@ double ns_per_ray(const BenchRow& r) { return r.mrays_single > 0 ? 1e3 / r.mrays
 std::string ratio_cell(double x) { return x > 0 ? fmt::format("{:.2f}", x) : std::string("–"); }
 
 std::string md_table_header() {
-  return "| mode | build s | Mrays/s single | Mrays/s packet | vs kd | vs embree | kd+bsp nodes/ray | tri tests/ray "
-         "| MB | bytes/tri | error rays | lost | extra | farther (leaks) | nearer | max t ulps | median t ulps |\n"
-         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  return "| mode | build s | Mrays/s single | Mrays/s packet | vs kd | vs embree | kd+bsp nodes/ray | box nodes/ray "
+         "| tri tests/ray | rule / Mpzf decisions per ray | rays to Mpzf | MB | bytes/tri | error rays | lost | extra "
+         "| farther (leaks) | nearer | max t ulps | median t ulps |\n"
+         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
 }
 
 std::string md_row(const BenchResult& res, const BenchRow& r) {
   const bool err = r.error_rays > 0;
   const auto cnt = [&](std::uint64_t v) { return err ? fmt::format("{}", v) : std::string("–"); };
-  const bool counted = r.kd_visits + r.bsp_visits + r.triangle_tests > 0;  // Embree has no counters
-  return fmt::format("| {} | {:.3f} | {:.2f} | {} | {} | {} | {} | {} | {:.1f} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+  const bool counted = r.kd_visits + r.bsp_visits + r.box_visits + r.triangle_tests > 0;  // Embree has no counters
+  const bool exact = bench_mode_is_certified(r.mode) && counted;  // the staged exact leaf test counts its stages
+  return fmt::format("| {} | {:.3f} | {:.2f} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1f} | {} | {} | {} | {} | {} | {} "
+                     "| {} | {} |\n",
                      r.mode, r.build_seconds, r.mrays_single,
                      r.packet_width > 1 ? fmt::format("{:.2f} ({})", r.mrays_packet, r.packet_width) : "single only",
                      ratio_cell(bench_speed_ratio(res, r, "kd")), ratio_cell(bench_speed_ratio(res, r, "embree")),
                      counted ? fmt::format("{:.1f}", r.kd_visits + r.bsp_visits) : "–",
-                     counted ? fmt::format("{:.2f}", r.triangle_tests) : "–", double(r.memory_bytes) / 1e6,
+                     counted ? fmt::format("{:.1f}", r.box_visits) : "–",
+                     counted ? fmt::format("{:.2f}", r.triangle_tests) : "–",
+                     exact ? fmt::format("{:.3f} / {:.4f}", r.rule_decisions, r.exact_decisions) : "–",
+                     exact ? fmt::format("{:.3f}%", 100.0 * r.exact_rays) : "–", double(r.memory_bytes) / 1e6,
                      r.triangles && r.memory_bytes ? fmt::format("{:.0f}", double(r.memory_bytes) / double(r.triangles))
                                                    : std::string("–"),
                      err ? fmt::format("{}", r.error_rays) : "–", cnt(r.error.lost), cnt(r.error.extra),
@@ -71,12 +77,13 @@ std::string json_row(const BenchResult& res, const BenchRow& r) {
       "\"bsp_visits\": {:.4f}, \"leaf_visits\": {:.4f}, \"triangle_tests\": {:.4f}, \"memory_bytes\": {}, "
       "\"hits\": {}, \"error_rays\": {}, \"lost\": {}, \"extra\": {}, \"farther\": {}, \"nearer\": {}, \"tie\": {}, "
       "\"max_t_ulps\": {:.1f}, \"median_t_ulps\": {:.1f}, \"leaks_per_million\": {:.2f}, \"speed_vs_kd\": {:.4f}, "
-      "\"speed_vs_embree\": {:.4f}}}",
+      "\"speed_vs_embree\": {:.4f}, \"box_visits\": {:.4f}, \"rule_decisions\": {:.6f}, \"exact_decisions\": {:.6f}, "
+      "\"exact_rays\": {:.6f}}}",
       json_string(r.scene), r.triangles, json_string(r.ray_set), json_string(r.mode), r.rays, r.build_seconds,
       r.mrays_single, r.mrays_packet, r.packet_width, r.kd_visits, r.bsp_visits, r.leaf_visits, r.triangle_tests,
       r.memory_bytes, r.hits, r.error_rays, r.error.lost, r.error.extra, r.error.farther, r.error.nearer, r.error.tie,
       r.error.max_t_ulps, r.median_t_ulps, leaks_per_million(r), bench_speed_ratio(res, r, "kd"),
-      bench_speed_ratio(res, r, "embree"));
+      bench_speed_ratio(res, r, "embree"), r.box_visits, r.rule_decisions, r.exact_decisions, r.exact_rays);
 }
 
 /// The modes of the run, in first-seen order.
@@ -181,7 +188,8 @@ std::vector<std::string> bench_csv_columns() {
           "mrays_single", "mrays_packet",  "packet_width", "kd_visits",     "bsp_visits",    "leaf_visits",
           "triangle_tests", "memory_bytes", "hits",        "error_rays",    "lost",          "extra",
           "farther",      "nearer",        "tie",         "max_t_ulps",     "median_t_ulps", "leaks_per_million",
-          "ns_per_ray",   "speed_vs_kd",   "speed_vs_embree"};
+          "ns_per_ray",   "speed_vs_kd",   "speed_vs_embree", "box_visits", "rule_decisions", "exact_decisions",
+          "exact_rays"};
 }
 
 std::string bench_csv(const BenchResult& res) {
@@ -190,12 +198,13 @@ std::string bench_csv(const BenchResult& res) {
   out += "\n";
   for (const BenchRow& r : res.rows)
     out += fmt::format("{},{},{},{},{},{:.6f},{:.4f},{:.4f},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{:.1f},"
-                       "{:.1f},{:.2f},{:.3f},{:.4f},{:.4f}\n",
+                       "{:.1f},{:.2f},{:.3f},{:.4f},{:.4f},{:.4f},{:.6f},{:.6f},{:.6f}\n",
                        r.scene, r.triangles, r.ray_set, r.mode, r.rays, r.build_seconds, r.mrays_single, r.mrays_packet,
                        r.packet_width, r.kd_visits, r.bsp_visits, r.leaf_visits, r.triangle_tests, r.memory_bytes, r.hits,
                        r.error_rays, r.error.lost, r.error.extra, r.error.farther, r.error.nearer, r.error.tie,
                        r.error.max_t_ulps, r.median_t_ulps, leaks_per_million(r), ns_per_ray(r),
-                       bench_speed_ratio(res, r, "kd"), bench_speed_ratio(res, r, "embree"));
+                       bench_speed_ratio(res, r, "kd"), bench_speed_ratio(res, r, "embree"), r.box_visits,
+                       r.rule_decisions, r.exact_decisions, r.exact_rays);
   return out;
 }
 

@@ -160,7 +160,7 @@ BenchRow measure_mode(const BuiltMode& m, const std::vector<Ray>& rays, const st
   const std::vector<Ray>& timed = is_slow_mode(m.mode) && !subset.empty() ? subset : rays;
   row.rays = timed.size();
   std::vector<Hit> hits;
-  const int runs = bench_mode_is_certified(m.mode) ? 1 : o.runs;  // slow modes: one pass
+  const int runs = is_slow_mode(m.mode) ? 1 : o.runs;  // slow modes (brute force, the exact reference): one pass
   row.mrays_single = double(timed.size()) / time_trace(*m.tracer, timed, hits, 1, runs) * 1e-6;
   row.hits = std::size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.hit(); }));
   // Certified modes and box tops trace packets as single rays: no packet row.
@@ -173,6 +173,10 @@ BenchRow measure_mode(const BuiltMode& m, const std::vector<Ray>& rays, const st
   row.bsp_visits = double(c.bsp_node_visits) / n;
   row.leaf_visits = double(c.leaf_visits) / n;
   row.triangle_tests = double(c.triangle_tests) / n;
+  row.box_visits = double(c.box_node_visits) / n;
+  row.rule_decisions = double(c.rule_decisions) / n;
+  row.exact_decisions = double(c.exact_decisions) / n;
+  row.exact_rays = double(c.exact_rays) / n;
   if (!subset.empty()) {
     std::vector<Hit> tested;
     time_trace(*m.tracer, subset, tested, 1, 1);

@@ -77,6 +77,13 @@ struct BenchRow {
   double bsp_visits = 0.0;        ///< general-plane node visits per ray
   double leaf_visits = 0.0;       ///< leaves per ray
   double triangle_tests = 0.0;    ///< triangle tests per ray
+  double box_visits = 0.0;        ///< box nodes per ray (bsp-top's box top, the BVH8)
+  // Exact leaf tests (docs/exact-leaf-test.md), per ray: decisions a rule on
+  // exact zeros made, decisions made in exact arithmetic (CGAL::Mpzf), and
+  // the share of rays with at least one of those (the heaviest stage).
+  double rule_decisions = 0.0;
+  double exact_decisions = 0.0;
+  double exact_rays = 0.0;
   std::size_t memory_bytes = 0;   ///< bytes of the structure
   std::size_t error_rays = 0;     ///< rays compared with the exact reference (0 = not measured)
   HitComparison error;            ///< lost, extra, farther (leaks), nearer, max t ulps

@@ -82,6 +82,16 @@ template <bool kLine>
   return simd::movemask<8>(tn <= tf);
 }
 
+/// Lane i of v, without a round trip through memory where the ISA has a
+/// variable permute (a store and a narrower reload can stall forwarding).
+[[gnu::always_inline]] inline float lane_of(V v, unsigned i) {
+#if defined(__AVX2__)
+  return _mm256_cvtss_f32(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(v), _mm256_set1_epi32(int(i))));
+#else
+  return v[i];
+#endif
+}
+
 /// Sort key: distance bits in an order that sorts like the floats (negative
 /// distances only for kLine), low 3 bits replaced by the slot.
 inline std::uint32_t key(float d, unsigned slot) {
@@ -223,7 +233,6 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       V d;
       unsigned m = box_test<kLine>(n, rc, tnear, tfar, d);
       if (m == 0) goto pop;
-      *reinterpret_cast<V*>(dist) = d;
       const unsigned s0 = unsigned(__builtin_ctz(m));
       m &= m - 1;
       if (m == 0) {
@@ -234,14 +243,15 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       const unsigned s1 = unsigned(__builtin_ctz(m));
       m &= m - 1;
       if (m == 0) {
-        const bool first = dist[s0] <= dist[s1];
-        const unsigned nearer = first ? s0 : s1, farther = first ? s1 : s0;
+        const float d0 = lane_of(d, s0), d1 = lane_of(d, s1);
+        const bool first = d0 <= d1;
         prefetch_ref(v, n.child[s0]);
         prefetch_ref(v, n.child[s1]);
-        stack[sp++] = {n.child[farther], dist[farther]};
-        ref = n.child[nearer];
+        stack[sp++] = {n.child[first ? s1 : s0], first ? d1 : d0};
+        ref = n.child[first ? s0 : s1];
         continue;
       }
+      *reinterpret_cast<V*>(dist) = d;
       std::uint32_t keys[8];
       int count = 0;
       keys[count++] = key(dist[s0], s0);
