@@ -88,6 +88,13 @@ TEST_CASE("bench: one row per ray set and mode, with error measured", "[bench]")
   CHECK(row("primary", "brute-certified").packet_width == 1);
   CHECK(row("primary", "bsp").memory_bytes > 0);
   CHECK(row("primary", "bsp").triangle_tests > 0.0);
+  // Stage counters of the exact leaf test: rays through vertices need its rules;
+  // the float modes and Embree count none.
+  CHECK(row("vertex", "bsp").rule_decisions > 0.0);
+  CHECK(row("vertex", "kd").rule_decisions > 0.0);
+  CHECK(row("vertex", "bsp").exact_rays <= 1.0);
+  CHECK(row("vertex", "bsp-float").rule_decisions == 0.0);
+  CHECK(row("vertex", "embree").rule_decisions == 0.0);
 }
 
 TEST_CASE("bench: exact against itself has zero error; certified modes lose nothing", "[bench]") {
