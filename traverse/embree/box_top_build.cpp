@@ -4,7 +4,6 @@
 /// and the result is copied into BoxTopNodes in depth-first order.
 #include <embree3/rtcore.h>
 
-#include <mutex>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -110,44 +109,24 @@ BoxTop build_box_top(std::span<const BspSubtreeBox> subtrees) {
     prims[i] = {b.lo.x, b.lo.y, b.lo.z, 0u, b.hi.x, b.hi.y, b.hi.z, std::uint32_t(i)};
   }
   // Rare (one build per tracer); Embree parallelizes each build itself.
-  const std::lock_guard<std::mutex> lock(detail::build_lock());
-  const RTCDevice device = detail::shared_build_device();
-  RTCBVH bvh = rtcNewBVH(device);
-  RTCBuildArguments args = rtcDefaultBuildArguments();
-  args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
-  args.maxBranchingFactor = 4;
-  args.maxDepth = kMaxDepth;
-  args.minLeafSize = 1;
-  args.maxLeafSize = 1;
-  args.traversalCost = 1.0f;
-  args.intersectionCost = 1.0f;
-  args.bvh = bvh;
-  args.primitives = prims.data();
-  args.primitiveCount = prims.size();
-  args.primitiveArrayCapacity = prims.size();
-  args.createNode = create_node;
-  args.setNodeChildren = set_children;
-  args.setNodeBounds = set_bounds;
-  args.createLeaf = create_leaf;
-  const auto* root = static_cast<const BuildNode*>(rtcBuildBVH(&args));
-  const RTCError err = rtcGetDeviceError(device);
+  detail::EmbreeBuildSettings settings;
+  settings.branching = 4;
+  settings.max_depth = kMaxDepth;
+  settings.max_leaf_size = 1;
+  settings.create_node = create_node;
+  settings.set_children = set_children;
+  settings.set_bounds = set_bounds;
+  settings.create_leaf = create_leaf;
+  const detail::EmbreeBuild build(prims, prims.size(), settings);
   Flattener f{subtrees, {}};
-  try {
-    if (err != RTC_ERROR_NONE || root == nullptr)
-      throw std::runtime_error("embree: rtcBuildBVH failed (code " + std::to_string(int(err)) + ")");
-    Box3f all;
-    const std::uint32_t ref = f.add(root, all);
-    if (ref & BoxTopNode::kSubtree) {  // a bare leaf at the root (not expected with >= 2 subtrees)
-      BoxTopNode n = empty_node();
-      set_child_box(n, 0, all);
-      n.child[0] = ref;
-      f.top.nodes.push_back(n);
-    }
-  } catch (...) {
-    rtcReleaseBVH(bvh);
-    throw;
+  Box3f all;
+  const std::uint32_t ref = f.add(static_cast<const BuildNode*>(build.root()), all);
+  if (ref & BoxTopNode::kSubtree) {  // a bare leaf at the root (not expected with >= 2 subtrees)
+    BoxTopNode n = empty_node();
+    set_child_box(n, 0, all);
+    n.child[0] = ref;
+    f.top.nodes.push_back(n);
   }
-  rtcReleaseBVH(bvh);
   f.top.subtrees = top.subtrees;
   return std::move(f.top);
 }

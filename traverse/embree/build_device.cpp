@@ -1,10 +1,12 @@
 /// \file build_device.cpp
-/// shared_build_device and build_lock (build_device.h).
+/// EmbreeBuild (build_device.h): the shared device, the lock, one rtcBuildBVH run.
 #include "traverse/embree/build_device.h"
 
 #include <stdexcept>
+#include <string>
 
 namespace bsprt::detail {
+namespace {
 
 RTCDevice shared_build_device() {
   struct Holder {
@@ -22,5 +24,37 @@ std::mutex& build_lock() {
   static std::mutex m;
   return m;
 }
+
+}  // namespace
+
+EmbreeBuild::EmbreeBuild(std::vector<RTCBuildPrimitive>& prims, std::size_t count, const EmbreeBuildSettings& s)
+    : lock_(build_lock()) {
+  const RTCDevice device = shared_build_device();
+  bvh_ = rtcNewBVH(device);
+  RTCBuildArguments args = rtcDefaultBuildArguments();
+  args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
+  args.maxBranchingFactor = s.branching;
+  args.maxDepth = s.max_depth;
+  args.minLeafSize = 1;
+  args.maxLeafSize = s.max_leaf_size;
+  args.traversalCost = s.traversal_cost;
+  args.intersectionCost = s.intersection_cost;
+  args.bvh = bvh_;
+  args.primitives = prims.data();
+  args.primitiveCount = count;
+  args.primitiveArrayCapacity = prims.size();
+  args.createNode = s.create_node;
+  args.setNodeChildren = s.set_children;
+  args.setNodeBounds = s.set_bounds;
+  args.createLeaf = s.create_leaf;
+  root_ = rtcBuildBVH(&args);
+  const RTCError err = rtcGetDeviceError(device);
+  if (err != RTC_ERROR_NONE || root_ == nullptr) {
+    rtcReleaseBVH(bvh_);
+    throw std::runtime_error("embree: rtcBuildBVH failed (code " + std::to_string(int(err)) + ")");
+  }
+}
+
+EmbreeBuild::~EmbreeBuild() { rtcReleaseBVH(bvh_); }
 
 }  // namespace bsprt::detail

@@ -1,20 +1,50 @@
 #pragma once
 /// \file build_device.h
-/// The one Embree device of the process for our own rtcBuildBVH builds (the
-/// box top, bsp_boxtop.h, and the BVH8, bvh8_build.h). Making a device starts
-/// Embree's worker threads, which would dominate a small build; builds on it
-/// are serialized with build_lock(), since Embree promises thread safety only
-/// for calls on different objects.
+/// Our own rtcBuildBVH builds (the box top, bsp_boxtop.h, and the BVH8,
+/// bvh8_build.h) in one place: one Embree device for the process (making a
+/// device starts Embree's worker threads, which would dominate a small build),
+/// builds on it serialized (Embree promises thread safety only for calls on
+/// different objects), and the BVH object whose memory holds the recorded
+/// nodes released when the caller has copied them.
 
 #include <embree3/rtcore.h>
 
+#include <cstddef>
 #include <mutex>
+#include <vector>
 
 namespace bsprt::detail {
 
-/// The shared device; throws std::runtime_error when Embree cannot make one.
-RTCDevice shared_build_device();
-/// Held around each build on the shared device.
-std::mutex& build_lock();
+/// What differs between our builds; the rest is Embree's medium-quality SAH build.
+struct EmbreeBuildSettings {
+  unsigned branching = 4;         ///< maxBranchingFactor
+  unsigned max_depth = 64;        ///< maxDepth
+  unsigned max_leaf_size = 1;     ///< maxLeafSize (minLeafSize is 1)
+  float traversal_cost = 1.0f;    ///< SAH cost of a node
+  float intersection_cost = 1.0f;  ///< SAH cost of a primitive
+  RTCCreateNodeFunction create_node = nullptr;
+  RTCSetNodeChildrenFunction set_children = nullptr;
+  RTCSetNodeBoundsFunction set_bounds = nullptr;
+  RTCCreateLeafFunction create_leaf = nullptr;
+};
+
+/// One rtcBuildBVH run over prims[0..count) (prims may be larger: spare
+/// capacity for the builder). Holds the build lock and the BVH object (whose
+/// memory holds what the callbacks allocated) until destroyed. Throws
+/// std::runtime_error when Embree fails.
+class EmbreeBuild {
+ public:
+  EmbreeBuild(std::vector<RTCBuildPrimitive>& prims, std::size_t count, const EmbreeBuildSettings& settings);
+  ~EmbreeBuild();
+  EmbreeBuild(const EmbreeBuild&) = delete;
+  EmbreeBuild& operator=(const EmbreeBuild&) = delete;
+  /// What create_node / create_leaf returned for the root.
+  const void* root() const { return root_; }
+
+ private:
+  std::lock_guard<std::mutex> lock_;
+  RTCBVH bvh_ = nullptr;
+  const void* root_ = nullptr;
+};
 
 }  // namespace bsprt::detail

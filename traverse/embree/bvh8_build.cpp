@@ -151,49 +151,31 @@ Bvh8Tree build_bvh8(const TriangleSoup& soup, const Bvh8Config& config) {
 
   const std::size_t count = prims.size();
   prims.resize(count * 2);  // Embree's builder may use spare capacity
-  const std::lock_guard<std::mutex> lock(detail::build_lock());
-  const RTCDevice device = detail::shared_build_device();
-  RTCBVH bvh = rtcNewBVH(device);
-  RTCBuildArguments args = rtcDefaultBuildArguments();
-  args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
-  args.maxBranchingFactor = 8;
-  args.maxDepth = kMaxDepth;
-  args.minLeafSize = 1;
-  args.maxLeafSize = config.max_leaf_size;
-  args.traversalCost = config.traversal_cost;
-  args.intersectionCost = config.intersection_cost;
-  args.bvh = bvh;
-  args.primitives = prims.data();
-  args.primitiveCount = count;
-  args.primitiveArrayCapacity = prims.size();
-  args.createNode = create_node;
-  args.setNodeChildren = set_children;
-  args.setNodeBounds = set_bounds;
-  args.createLeaf = create_leaf;
-  const auto* root = static_cast<const BuildNode*>(rtcBuildBVH(&args));
-  const RTCError err = rtcGetDeviceError(device);
-  try {
-    if (err != RTC_ERROR_NONE || root == nullptr)
-      throw std::runtime_error("embree: rtcBuildBVH failed (code " + std::to_string(int(err)) + ")");
-    Bvh8Node top = Bvh8Node::empty();
-    if (root->leaf) {  // a small scene: one leaf (or a few) under the root
+  detail::EmbreeBuildSettings settings;
+  settings.branching = 8;
+  settings.max_depth = kMaxDepth;
+  settings.max_leaf_size = config.max_leaf_size;
+  settings.traversal_cost = config.traversal_cost;
+  settings.intersection_cost = config.intersection_cost;
+  settings.create_node = create_node;
+  settings.set_children = set_children;
+  settings.set_bounds = set_bounds;
+  settings.create_leaf = create_leaf;
+  const detail::EmbreeBuild build(prims, count, settings);
+  const auto* root = static_cast<const BuildNode*>(build.root());
+  Bvh8Node top = Bvh8Node::empty();
+  if (root->leaf) {  // a small scene: one leaf (or a few) under the root
+    Box3f b;
+    top.set(0, f.long_leaf(root->prims, root->count, b, 2), b);
+  } else {
+    if (root->count > 8) Flattener::fail("made a node of more than 8 children");
+    for (unsigned i = 0; i < root->count; ++i) {
       Box3f b;
-      const std::uint32_t ref = f.long_leaf(root->prims, root->count, b, 2);
-      top.set(0, ref, b);
-    } else {
-      if (root->count > 8) Flattener::fail("made a node of more than 8 children");
-      for (unsigned i = 0; i < root->count; ++i) {
-        Box3f b;
-        top.set(int(i), f.add(root->child[i], b, 2), b);
-      }
+      top.set(int(i), f.add(root->child[i], b, 2), b);
     }
-    f.tree.nodes[0] = top;
-    f.tree.leaf_soa.insert(f.tree.leaf_soa.end(), 3, 0.0f);  // a row's four-float load may read past the last
-  } catch (...) {
-    rtcReleaseBVH(bvh);
-    throw;
   }
-  rtcReleaseBVH(bvh);
+  f.tree.nodes[0] = top;
+  f.tree.leaf_soa.insert(f.tree.leaf_soa.end(), 3, 0.0f);  // a row's four-float load may read past the last
   return std::move(f.tree);
 }
 
