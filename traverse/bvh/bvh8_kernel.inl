@@ -200,6 +200,40 @@ inline void intersect_leaf(const WatertightRay& r, const float* rows, const std:
   hit.v = w[best] * rcp;
 }
 
+/// The lanes (bits) of a leaf that the exact leaf test must see: a lane is
+/// left out when float arithmetic with a forward error bound proves that two
+/// of its edge weights have opposite signs, so the exact test would call it a
+/// miss (docs/bvh8.md, "Exact leaves"). The weights are the watertight test's
+/// sheared 2D cross products of the corners relative to the origin; in float
+/// their error is below 20.1 u Mx My (u = 2^-24, Mx and My bound
+/// |a[kx]| + |sx| |a[kz]| and |a[ky]| + |sy| |a[kz]| over the corners), and
+/// below 2^-146 more from underflow; the bound used, max(2^-18 Mx My, 2^-120),
+/// covers both. A NaN or infinite bound proves nothing.
+inline unsigned exact_lanes(const WatertightRay& r, const float* rows, std::uint32_t count) {
+  using V4 = simd::vfloat<4>;
+  using M4 = simd::vmask<4>;
+  const auto lane = [&](int c, int k) { return simd::load<4>(rows + (3 * c + k) * count); };
+  const V4 sx = simd::splat<4>(r.sx), sy = simd::splat<4>(r.sy);
+  const V4 asx = simd::abs<4>(sx), asy = simd::abs<4>(sy);
+  V4 x[3], y[3], mx = simd::splat<4>(0.0f), my = simd::splat<4>(0.0f);
+  for (int c = 0; c < 3; ++c) {
+    const V4 az = lane(c, r.kz) - r.org[r.kz], ax = lane(c, r.kx) - r.org[r.kx], ay = lane(c, r.ky) - r.org[r.ky];
+    x[c] = ax - no_fma(sx * az);
+    y[c] = ay - no_fma(sy * az);
+    const V4 aaz = simd::abs<4>(az);
+    mx = simd::max<4>(simd::abs<4>(ax) + asx * aaz, mx);
+    my = simd::max<4>(simd::abs<4>(ay) + asy * aaz, my);
+  }
+  const V4 u = no_fma(x[1] * y[2]) - no_fma(y[1] * x[2]);
+  const V4 v = no_fma(x[2] * y[0]) - no_fma(y[2] * x[0]);
+  const V4 w = no_fma(x[0] * y[1]) - no_fma(y[0] * x[1]);
+  const V4 bound = simd::max<4>(0x1p-18f * (mx * my), simd::splat<4>(0x1p-120f));
+  const M4 pos = (u > bound) | (v > bound) | (w > bound);
+  const M4 neg = (u < -bound) | (v < -bound) | (w < -bound);
+  const unsigned all = (1u << count) - 1u;
+  return all & ~simd::movemask<4>(pos & neg);
+}
+
 template <bool kCount, bool kLine>
 Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
   const Bvh8RayRecip rr = bvh8_reciprocals(ray);
@@ -274,8 +308,24 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       const std::uint32_t first = Bvh8Node::index(ref), count = Bvh8Node::count(ref);
       if constexpr (kCount) ++c->leaf_visits;
       if (v.exact_leaf) {
-        v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, count), v.triangles + first,
-                                nearest, kCount ? c : nullptr);
+        // Triangles the float filter proves missed never reach the exact test.
+        if (!sheared) wr = watertight_precompute(ray), sheared = true;
+        const unsigned lanes = exact_lanes(wr, v.leaf_soa + 9 * std::size_t(first), count);
+        if (lanes == (1u << count) - 1u) {
+          v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, count), v.triangles + first,
+                                  nearest, kCount ? c : nullptr);
+        } else if (lanes != 0) {
+          std::uint32_t p[4];
+          LeafTriangle t[4];
+          std::uint32_t n = 0;
+          for (unsigned m = lanes; m; m &= m - 1, ++n) {
+            const unsigned i = unsigned(__builtin_ctz(m));
+            p[n] = v.prims[first + i];
+            t[n] = v.triangles[first + i];
+          }
+          v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(p, n), t, nearest, kCount ? c : nullptr);
+        }
+        if constexpr (kCount) c->triangle_tests += count - std::uint32_t(__builtin_popcount(lanes));
         const float cull = cull_bound(nearest);
         tfar = cull < tfar ? cull : tfar;
       } else {
