@@ -32,7 +32,7 @@ mkdir -p "$PERF" "$GAL"
 MESHES=(suzanne.obj utah-teapot.obj happy-buddha-res4.ply stanford-bunny.obj armadillo-86k.obj stanford-dragon-100k.ply)
 mesh_paths=()
 for m in "${MESHES[@]}"; do mesh_paths+=("$SCENES/$m"); done
-MODES=kd,kd-float,bsp,bsp-float,bsp-top,bsp-zero-eps,embree,embree-fast
+MODES=kd,kd-float,bsp,bsp-float,bsp-top,bsp-zero-eps,bvh8,bvh8-float,embree,embree-fast
 
 # 1. Every mode, every mesh, four ray sets: speed, work, memory, error.
 BENCH_CMD=(bench "${mesh_paths[@]}" --rays primary,random,vertex,edge --modes "$MODES"

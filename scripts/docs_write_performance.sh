@@ -47,7 +47,7 @@ Every number below is in the files of \`docs/perf/\` that the same run wrote.*
 | | |
 |---|---|
 | machine | $(lscpu | awk -F: '/Model name/ { gsub(/^ +/, "", $2); print $2; exit }'), $(nproc) logical cores; **${threads} threads** for every mode |
-| SIMD | widest ISA detected: ${isa} (packets of ${width}); certified modes and bsp-top trace single rays |
+| SIMD | widest ISA detected: ${isa} (packets of ${width}); bsp-top, bvh8 and bvh8-float trace single rays only |
 | compiler | $("$compiler" --version | head -1) |
 | flags | \`${flags}\` (CMake Release), BSPRT_MARCH=${march:-default} |
 | commit | ${commit} |
@@ -60,6 +60,8 @@ is incoherent and unbounded, not camera rays, docs/certified-epsilons.md §11; *
 watertight float triangle test; **bsp-top** the same tree under a 4-wide box top over
 subtrees of ≤ 1024 slots (single rays only, exact leaves; docs/certified-epsilons.md §10);
 **bsp-zero-eps** the same tree with all epsilons 0 and float leaves;
+**bvh8** / **bvh8-float** a plain 8-wide BVH traced by an Embree-style single-ray kernel, exact / float leaves
+(docs/bvh8.md; no BSP below it yet);
 **embree** Embree 3 robust mode; **embree-fast** Embree 3 default mode; **brute-certified** every
 triangle, decided exactly. Error is measured ray by ray against \`ExactTracer\` (CGAL exact
 ray/triangle intersection on the same float rays), in the vocabulary of \`bsprt compare\`: *lost* (reference
