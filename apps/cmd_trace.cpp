@@ -179,7 +179,7 @@ void run(const TraceArgs& a) {
   if (a.stats)
     fmt::print("per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests{}\n",
                c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n,
-               c.box_node_visits ? fmt::format(", {:.3f} box-top node visits", c.box_node_visits / n) : "");
+               c.box_node_visits ? fmt::format(", {:.3f} box node visits", c.box_node_visits / n) : "");
   if (a.stats && accel_info(a.trace.accel).certified)
     fmt::print("exact leaf decisions per ray: {:.5f} by a rule on exact zeros, {:.5f} in exact arithmetic; "
                "{} of {} rays ({:.4f} %) reached exact arithmetic\n",

@@ -181,7 +181,7 @@ TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {
                            tree + " --stats");
   INFO(ts.output);
   CHECK(ts.status == 0);
-  CHECK(ts.output.find("box-top node visits") != std::string::npos);
+  CHECK(ts.output.find("box node visits") != std::string::npos);
   CHECK(bsprt_cli("trace " + scene + " " + rays + " -o " + temp_path("x.hits") + " --accel bsp-top --top-slots 0")
             .status == 2);
 

@@ -15,7 +15,7 @@ struct RayCounters {
   std::uint64_t bsp_node_visits = 0;  ///< inner nodes with a general plane
   std::uint64_t leaf_visits = 0;      ///< leaves entered
   std::uint64_t triangle_tests = 0;   ///< ray/triangle tests run
-  std::uint64_t box_node_visits = 0;  ///< 4-wide box nodes of a box top (bsp_boxtop.h)
+  std::uint64_t box_node_visits = 0;  ///< box nodes: 4-wide of a box top (bsp_boxtop.h), 8-wide of the BVH8 (bvh8_node.h)
   /// Exact-decision leaf tests (robust/certified_intersector.h): decisions
   /// the double filter could not make that a rule on exact zeros made (a ray
   /// through a vertex, hits at one vertex, edge or triangle tied), decisions
