@@ -91,7 +91,7 @@ void Tracer::intersect(std::span<const Ray> rays, std::span<Hit> hits, const Tra
   });
 }
 
-bool Tracer::occluded(const Ray& ray) const { return impl_->accel->trace(ray).hit(); }
+bool Tracer::occluded(const Ray& ray) const { return impl_->accel->occluded(ray); }
 
 void Tracer::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded, const TraceOptions& options) const {
   check_options(options);
@@ -99,6 +99,10 @@ void Tracer::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occlude
     throw UsageError("occluded: " + std::to_string(rays.size()) + " rays but room for " +
                      std::to_string(occluded.size()) + " answers");
   for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
+    if (options.packet_width <= 1) {  // single rays: the tracer's own any-hit query (the BVH8 stops at a first hit)
+      for (std::size_t i = b; i < e; ++i) occluded[i] = impl_->accel->occluded(rays[i]) ? 1 : 0;
+      return;
+    }
     std::vector<Hit> hits(e - b);
     impl_->accel->trace_batch(rays.subspan(b, e - b), hits, options.packet_width);
     for (std::size_t i = b; i < e; ++i) occluded[i] = hits[i - b].hit() ? 1 : 0;

@@ -115,6 +115,19 @@ RayCounters trace_all(const Accelerator& tracer, const std::vector<Ray>& rays, s
   return c;
 }
 
+/// --occluded with single rays: the tracer's any-hit query (occluded), in
+/// parallel blocks; occ[i] = 1 when ray i hits something. Returns the summed
+/// counters when `count`.
+RayCounters occlude_all(const Accelerator& tracer, const std::vector<Ray>& rays, std::vector<std::uint8_t>& occ,
+                        bool count) {
+  tbb::combinable<RayCounters> local;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& r) {
+    RayCounters* c = count ? &local.local() : nullptr;
+    for (std::size_t i = r.begin(); i < r.end(); ++i) occ[i] = tracer.occluded(rays[i], c) ? 1 : 0;
+  });
+  return local.combine([](RayCounters x, const RayCounters& y) { return x += y; });
+}
+
 void run(const TraceArgs& a) {
   const auto threads = limit_threads(a.trace.threads);
   if (a.all_hits && (a.occluded || a.face_hits || a.stats))
@@ -134,26 +147,38 @@ void run(const TraceArgs& a) {
   // The timed region holds the traversal only: rays checked and the output
   // written before it (std::vector zero-fills, so every page is touched), no
   // counters; the fastest of --passes counts. --stats counts in a pass of its own.
-  std::vector<Hit> hits(rays.size());
+  // --occluded with single rays asks the tracer's any-hit query (occluded);
+  // with packets, the nearest hit decides. Both are exact with a certified accelerator.
+  const bool any_hit = a.occluded && a.trace.packets <= 1;
+  std::vector<Hit> hits(any_hit ? 0 : rays.size());
+  std::vector<std::uint8_t> occ(any_hit ? rays.size() : 0);
   double trace_s = 1e300;
   for (int pass = 0; pass < a.passes; ++pass) {
     const auto t1 = std::chrono::steady_clock::now();
-    trace_all(*tracer, rays, hits, a.trace.packets, false);
+    if (any_hit)
+      occlude_all(*tracer, rays, occ, false);
+    else
+      trace_all(*tracer, rays, hits, a.trace.packets, false);
     trace_s = std::min(trace_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
   }
-  const RayCounters c = a.stats ? trace_all(*tracer, rays, hits, a.trace.packets, true) : RayCounters{};
-  if (a.occluded) {  // any hit in [tnear, tfar]: the nearest one decides (exact with a certified accelerator)
+  RayCounters c;
+  if (a.stats) c = any_hit ? occlude_all(*tracer, rays, occ, true) : trace_all(*tracer, rays, hits, a.trace.packets, true);
+  std::size_t nhit = 0;
+  if (a.occluded) {  // any hit in [tnear, tfar], 0 or 1 per ray
     std::ofstream out(a.hits);
     if (!out) throw InputError(a.hits, "cannot write");
-    for (const Hit& h : hits) out << (h.hit() ? "1\n" : "0\n");
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const bool h = any_hit ? occ[i] != 0 : hits[i].hit();
+      nhit += h ? 1 : 0;
+      out << (h ? "1\n" : "0\n");
+    }
     if (!out) throw InputError(a.hits, "write failed");
   } else {
     write_hits(a.hits, hits);
+    for (const Hit& h : hits) nhit += h.hit();
   }
   const FaceHitFigures face = a.face_hits ? count_face_hits(a, soup, hits) : FaceHitFigures{};
 
-  std::size_t nhit = 0;
-  for (const Hit& h : hits) nhit += h.hit();
   const double mrays = trace_s > 0 ? double(rays.size()) / trace_s * 1e-6 : 0.0;
   const double n = rays.empty() ? 1.0 : double(rays.size());
   if (a.json) {

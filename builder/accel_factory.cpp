@@ -62,6 +62,7 @@ class ExactLeafTracer final : public Accelerator {
   Tracer& tracer() { return tracer_; }
   std::string name() const override { return tracer_.name(); }
   Hit trace(const Ray& ray, RayCounters* counters) const override { return tracer_.trace(ray, counters); }
+  bool occluded(const Ray& ray, RayCounters* counters) const override { return tracer_.occluded(ray, counters); }
   void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
                    RayCounters* counters) const override {
     tracer_.trace_batch(rays, hits, packet_width, counters);

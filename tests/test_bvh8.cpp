@@ -21,6 +21,7 @@
 #include "geometry/scenes/stiff_rays.h"
 #include "geometry/scenes/stiff_scenes.h"
 #include "robust/certified_intersector.h"
+#include "robust/degenerate.h"
 #include "robust/exact_tracer.h"
 #include "test_util.h"
 #include "traverse/brute_force.h"
@@ -236,4 +237,80 @@ TEST_CASE("bvh8: coordinates beyond 2^126 are traced exactly", "[bvh8]") {
   r.dir = {-1, 0, 0};
   CHECK(b->trace(r).hit());
   CHECK(b->trace(r).prim == e.trace(r).prim);
+}
+
+// Any-hit queries stop at the first hit a leaf proves: the same answer as the
+// nearest hit, with less work on rays that hit.
+TEST_CASE("bvh8: occluded equals trace().hit() and stops early", "[bvh8]") {
+  const TriangleSoup soup = load_mesh(test::scene_path("utah-teapot.obj"));
+  const std::vector<Ray> rays = test_rays(soup, 1000);
+  for (const char* mode : {"bvh8", "bvh8-float"}) {
+    const auto t = make_tracer(mode, soup);
+    RayCounters nearest, any;
+    std::size_t differ = 0, hits = 0;
+    for (const Ray& r : rays) {
+      const bool h = t->trace(r, &nearest).hit();
+      differ += h != t->occluded(r, &any) ? 1 : 0;
+      hits += h ? 1 : 0;
+    }
+    INFO(mode << ": " << differ << " of " << rays.size() << " rays differ, " << hits << " hit");
+    CHECK(differ == 0);
+    CHECK(hits > rays.size() / 4);
+    CHECK(any.rays == nearest.rays);
+    CHECK(any.box_node_visits < nearest.box_node_visits);
+    CHECK(any.triangle_tests < nearest.triangle_tests);
+  }
+}
+
+namespace {
+
+TriangleSoup one_triangle(Vec3f a, Vec3f b, Vec3f c) {
+  TriangleSoup s;
+  s.vertices = {a, b, c};
+  s.triangles = {{0, 1, 2}};
+  classify_degenerate(s);
+  return s;
+}
+
+/// bvh8 (exact leaves) and the exact reference agree on `ray`, which hits.
+void check_exact_hit(const TriangleSoup& s, const Ray& ray) {
+  const ExactTracer exact(s);
+  const auto bvh = exact_bvh8(s);
+  const Hit e = exact.trace(ray), h = bvh->trace(ray);
+  REQUIRE(e.hit());
+  CHECK(h.prim == e.prim);
+  CHECK(h.t == e.t);
+  CHECK(bvh->occluded(ray));
+}
+
+}  // namespace
+
+// Found reviewing the exact leaves' float filter (issue #26): with a direction
+// component of 2^-149 the shear sx rounds to a subnormal with far more than
+// 2^-24 relative error, and the filter's bound called a hit a certain miss.
+// A ray with a nonzero subnormal shear now keeps every lane.
+TEST_CASE("bvh8: a subnormal shear does not let the float filter drop a hit", "[bvh8][regression]") {
+  const float z = 0x1p120f;
+  Ray r;
+  r.org = {0, 0, 0};
+  r.dir = {0x1p-149f, 0, 1.5f};
+  check_exact_hit(one_triangle({0x1p-30f, -1, z}, {0x1p-30f, 1, z}, {0x1.ap-30f, 0, z}), r);
+  // sx = 2^-140 exactly, but subnormal: its products with a[kz] underflow too.
+  const float w = 1.0f + 9 * 0x1p-13f;
+  r.dir = {0x1p-140f, 0, 1};
+  check_exact_hit(one_triangle({-600 * 0x1p-149f, 0, 1}, {513 * 0x1p-149f, 0x1p40f, w}, {512 * 0x1p-149f, -0x1p41f, w}),
+                  r);
+}
+
+// The same review: with a normal shear (2^-126) the products sx a[kz] can still
+// underflow, each 2^-150 off, which the weights scale by My; the bound gained
+// 2^-145 (Mx + My). The sheared corners equal the second ray's above.
+TEST_CASE("bvh8: an underflowing shear product does not let the float filter drop a hit", "[bvh8][regression]") {
+  const float w = (1.0f + 9 * 0x1p-13f) * 0x1p-14f;
+  Ray r;
+  r.org = {0, 0, 0};
+  r.dir = {0x1p-126f, 0, 1};
+  check_exact_hit(one_triangle({-600 * 0x1p-149f, 0, 0x1p-14f}, {513 * 0x1p-149f, 0x1p40f, w},
+                               {512 * 0x1p-149f, -0x1p41f, w}),
+                  r);
 }

@@ -34,6 +34,13 @@ class Accelerator {
     for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
   }
 
+  /// Whether the ray hits anything in [tnear, tfar] (shadow and any-hit rays):
+  /// exactly trace(ray).hit(). A tracer may stop at the first hit it finds
+  /// (the BVH8 does); the default traces the nearest hit. Counts as trace does.
+  virtual bool occluded(const Ray& ray, RayCounters* counters = nullptr) const {
+    return trace(ray, counters).hit();
+  }
+
   /// Bytes held by the acceleration structure (0 for brute force).
   virtual std::size_t memory_bytes() const { return 0; }
 };

@@ -61,5 +61,9 @@ inline Bvh8RayRecip bvh8_reciprocals(const Ray& ray) {
 Hit bvh8_trace_avx512(const Bvh8View& view, const Ray& ray, RayCounters* c);
 Hit bvh8_trace_avx2(const Bvh8View& view, const Ray& ray, RayCounters* c);
 Hit bvh8_trace_base(const Bvh8View& view, const Ray& ray, RayCounters* c);
+/// Any hit in [tnear, tfar]: the same traversal, stopped at the first hit.
+bool bvh8_occluded_avx512(const Bvh8View& view, const Ray& ray, RayCounters* c);
+bool bvh8_occluded_avx2(const Bvh8View& view, const Ray& ray, RayCounters* c);
+bool bvh8_occluded_base(const Bvh8View& view, const Ray& ray, RayCounters* c);
 
 }  // namespace bsprt::detail

@@ -33,8 +33,8 @@
 #include "traverse/simd/simd.h"
 #include "traverse/watertight.h"
 
-#ifndef BSPRT_BVH8_ENTRY
-#error "define BSPRT_BVH8_ENTRY before including bvh8_kernel.inl"
+#if !defined(BSPRT_BVH8_ENTRY) || !defined(BSPRT_BVH8_OCCLUDED)
+#error "define BSPRT_BVH8_ENTRY and BSPRT_BVH8_OCCLUDED before including bvh8_kernel.inl"
 #endif
 
 namespace bsprt::detail {
@@ -206,9 +206,18 @@ inline void intersect_leaf(const WatertightRay& r, const float* rows, const std:
 /// miss (docs/bvh8.md, "Exact leaves"). The weights are the watertight test's
 /// sheared 2D cross products of the corners relative to the origin; in float
 /// their error is below 20.1 u Mx My (u = 2^-24, Mx and My bound
-/// |a[kx]| + |sx| |a[kz]| and |a[ky]| + |sy| |a[kz]| over the corners), and
-/// below 2^-146 more from underflow; the bound used, max(2^-18 Mx My, 2^-120),
-/// covers both. A NaN or infinite bound proves nothing.
+/// |a[kx]| + |sx| |a[kz]| and |a[ky]| + |sy| |a[kz]| over the corners) plus
+/// 2^-149 (Mx + My + 1) from underflowing products; the bound used,
+/// max(2^-18 Mx My, 2^-145 (Mx + My), 2^-120), covers both. The relative
+/// bound needs a normal shear: a ray whose nonzero sx or sy is below 2^-126
+/// (`filterable` false) keeps every lane, as does a NaN or infinite bound.
+/// Regression tests "bvh8: a subnormal shear ..." and "bvh8: an underflowing
+/// shear product ..." (tests/test_bvh8.cpp; found in review).
+inline bool filterable(const WatertightRay& r, const Ray& ray) {
+  const auto normal_or_exact_zero = [](float s, float d) { return d == 0.0f || std::abs(s) >= 0x1p-126f; };
+  return normal_or_exact_zero(r.sx, ray.dir[r.kx]) && normal_or_exact_zero(r.sy, ray.dir[r.ky]);
+}
+
 inline unsigned exact_lanes(const WatertightRay& r, const float* rows, std::uint32_t count) {
   using V4 = simd::vfloat<4>;
   using M4 = simd::vmask<4>;
@@ -227,19 +236,21 @@ inline unsigned exact_lanes(const WatertightRay& r, const float* rows, std::uint
   const V4 u = no_fma(x[1] * y[2]) - no_fma(y[1] * x[2]);
   const V4 v = no_fma(x[2] * y[0]) - no_fma(y[2] * x[0]);
   const V4 w = no_fma(x[0] * y[1]) - no_fma(y[0] * x[1]);
-  const V4 bound = simd::max<4>(0x1p-18f * (mx * my), simd::splat<4>(0x1p-120f));
+  const V4 bound =
+      simd::max<4>(simd::max<4>(0x1p-18f * (mx * my), 0x1p-145f * (mx + my)), simd::splat<4>(0x1p-120f));
   const M4 pos = (u > bound) | (v > bound) | (w > bound);
   const M4 neg = (u < -bound) | (v < -bound) | (w < -bound);
   const unsigned all = (1u << count) - 1u;
   return all & ~simd::movemask<4>(pos & neg);
 }
 
-template <bool kCount, bool kLine>
+/// kAnyHit: stop at the first hit (occluded); the traversal up to it is the nearest-hit one.
+template <bool kCount, bool kLine, bool kAnyHit>
 Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
   const Bvh8RayRecip rr = bvh8_reciprocals(ray);
   // The watertight shear, made at the first leaf: most random rays reach none.
   WatertightRay wr;
-  bool sheared = false;
+  bool sheared = false, filter = false;
   RayConst rc;
   for (int k = 0; k < 3; ++k) {
     rc.o[k] = simd::splat<8>(ray.org[k]);
@@ -309,8 +320,9 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       if constexpr (kCount) ++c->leaf_visits;
       if (v.exact_leaf) {
         // Triangles the float filter proves missed never reach the exact test.
-        if (!sheared) wr = watertight_precompute(ray), sheared = true;
-        const unsigned lanes = exact_lanes(wr, v.leaf_soa + 9 * std::size_t(first), count);
+        if (!sheared) wr = watertight_precompute(ray), sheared = true, filter = filterable(wr, ray);
+        const unsigned lanes =
+            filter ? exact_lanes(wr, v.leaf_soa + 9 * std::size_t(first), count) : (1u << count) - 1u;
         if (lanes == (1u << count) - 1u) {
           v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, count), v.triangles + first,
                                   nearest, kCount ? c : nullptr);
@@ -326,12 +338,14 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
           v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(p, n), t, nearest, kCount ? c : nullptr);
         }
         if constexpr (kCount) c->triangle_tests += count - std::uint32_t(__builtin_popcount(lanes));
+        if (kAnyHit && nearest.hit.hit()) return nearest.hit;
         const float cull = cull_bound(nearest);
         tfar = cull < tfar ? cull : tfar;
       } else {
         if constexpr (kCount) c->triangle_tests += count;
         if (!sheared) wr = watertight_precompute(ray), sheared = true;
         intersect_leaf(wr, v.leaf_soa + 9 * std::size_t(first), v.prims + first, count, hit);
+        if (kAnyHit && hit.hit()) return hit;
         tfar = hit.t < tfar ? hit.t : tfar;
       }
     }
@@ -347,12 +361,13 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
   }
 }
 
-template <bool kCount>
+template <bool kCount, bool kAnyHit>
 Hit trace_counted(const Bvh8View& v, const Ray& ray, RayCounters* c) {
   if constexpr (kCount) ++c->rays;
   if (!is_valid(ray)) return Hit{};
   const auto walk = [&] {
-    return ray.tnear >= 0.0f ? trace_kernel<kCount, false>(v, ray, c) : trace_kernel<kCount, true>(v, ray, c);
+    return ray.tnear >= 0.0f ? trace_kernel<kCount, false, kAnyHit>(v, ray, c)
+                             : trace_kernel<kCount, true, kAnyHit>(v, ray, c);
   };
   if constexpr (kCount) {
     const std::uint64_t before = c->exact_decisions;  // set by an exact leaf test
@@ -368,7 +383,11 @@ Hit trace_counted(const Bvh8View& v, const Ray& ray, RayCounters* c) {
 }  // namespace BSPRT_ISA_NAMESPACE
 
 Hit BSPRT_BVH8_ENTRY(const Bvh8View& view, const Ray& ray, RayCounters* c) {
-  return c ? trace_counted<true>(view, ray, c) : trace_counted<false>(view, ray, nullptr);
+  return c ? trace_counted<true, false>(view, ray, c) : trace_counted<false, false>(view, ray, nullptr);
+}
+
+bool BSPRT_BVH8_OCCLUDED(const Bvh8View& view, const Ray& ray, RayCounters* c) {
+  return (c ? trace_counted<true, true>(view, ray, c) : trace_counted<false, true>(view, ray, nullptr)).hit();
 }
 
 }  // namespace bsprt::detail

@@ -5,4 +5,5 @@
 // about their ABI all the same.
 #pragma GCC diagnostic ignored "-Wpsabi"
 #define BSPRT_BVH8_ENTRY bvh8_trace_base
+#define BSPRT_BVH8_OCCLUDED bvh8_occluded_base
 #include "traverse/bvh/bvh8_kernel.inl"

@@ -72,8 +72,7 @@ Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
     if (counters) ++counters->rays;
     return is_valid(ray) ? trace_every_triangle(ray, counters) : Hit{};
   }
-  const detail::Bvh8View v{tree_.nodes.data(), tree_.leaf_soa.data(), tree_.prims.data(), tree_.triangles.data(),
-                           exact_leaf_};
+  const detail::Bvh8View v = view();
   switch (isa_) {
     case Isa::Avx512:
       return detail::bvh8_trace_avx512(v, ray, counters);
@@ -82,6 +81,23 @@ Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
     default:
       return detail::bvh8_trace_base(v, ray, counters);
   }
+}
+
+bool Bvh8Tracer::occluded(const Ray& ray, RayCounters* counters) const {
+  if (huge_scene_ || !(max_abs(ray.org) <= kHuge)) return trace(ray, counters).hit();
+  const detail::Bvh8View v = view();
+  switch (isa_) {
+    case Isa::Avx512:
+      return detail::bvh8_occluded_avx512(v, ray, counters);
+    case Isa::Avx2:
+      return detail::bvh8_occluded_avx2(v, ray, counters);
+    default:
+      return detail::bvh8_occluded_base(v, ray, counters);
+  }
+}
+
+detail::Bvh8View Bvh8Tracer::view() const {
+  return {tree_.nodes.data(), tree_.leaf_soa.data(), tree_.prims.data(), tree_.triangles.data(), exact_leaf_};
 }
 
 }  // namespace bsprt
