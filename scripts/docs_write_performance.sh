@@ -27,9 +27,13 @@ path_table() {
 compiler=$(awk -F= '/^CMAKE_CXX_COMPILER:/ { print $2 }' "$BUILD/CMakeCache.txt")
 flags=$(awk -F= '/^CMAKE_CXX_FLAGS:/ { a = $2 } /^CMAKE_CXX_FLAGS_RELEASE:/ { b = $2 } END { print a " " b }' "$BUILD/CMakeCache.txt")
 march=$(awk -F= '/^BSPRT_MARCH:/ { print $2 }' "$BUILD/CMakeCache.txt")
-threads=$(grep -o '"threads": [0-9]*' "$PERF/bench.json" | head -1 | grep -o '[0-9]*$')
-isa=$(grep -o '"isa": "[a-z0-9]*"' "$PERF/bench.json" | head -1 | cut -d'"' -f4)
-width=$(grep -o '"packet_width": [0-9]*' "$PERF/bench.json" | head -1 | grep -o '[0-9]*$')
+# The run's context is at the start of bench.json. (Not `grep | head -1`: with
+# pipefail, grep killed by SIGPIPE once head has its line fails the script, and
+# whether it is depends on timing and on the file's size.)
+json=$(<"$PERF/bench.json")
+[[ $json =~ \"threads\":\ ([0-9]+) ]] && threads=${BASH_REMATCH[1]}
+[[ $json =~ \"isa\":\ \"([a-z0-9.]+)\" ]] && isa=${BASH_REMATCH[1]}
+[[ $json =~ \"packet_width\":\ ([0-9]+) ]] && width=${BASH_REMATCH[1]}
 fit=$(cat "$PERF/scaling-fit.txt")
 # The run's own outputs (docs/perf, docs/gallery, this page) differ from HEAD by
 # now; only changes elsewhere mean the numbers came from uncommitted code.
@@ -48,7 +52,7 @@ Every number below is in the files of \`docs/perf/\` that the same run wrote.*
 |---|---|
 | machine | $(lscpu | awk -F: '/Model name/ { gsub(/^ +/, "", $2); print $2; exit }'), $(nproc) logical cores; **${threads} threads** for every mode |
 | SIMD | widest ISA detected: ${isa} (packets of ${width}); bsp-top, bvh8 and bvh8-float trace single rays only |
-| compiler | $("$compiler" --version | head -1) |
+| compiler | $("$compiler" --version | sed -n 1p) |
 | flags | \`${flags}\` (CMake Release), BSPRT_MARCH=${march:-default} |
 | commit | ${commit} |
 | Embree | $(dpkg-query -W -f='${Version}' libembree-dev 2>/dev/null || echo "?") (Debian libembree-dev) |
