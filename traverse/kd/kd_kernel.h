@@ -5,10 +5,14 @@
 /// constants both must use identically, and the kernel entry points.
 
 #include <cstdint>
+#include <span>
 
 #include "bsprt/ray.h"
 #include "traverse/counters.h"
 #include "traverse/kd/kd_traverse.h"
+#include "traverse/exact_prefilter.h"
+#include "traverse/simd/simd.h"
+#include "traverse/watertight.h"
 
 namespace bsprt::detail {
 
@@ -26,6 +30,39 @@ struct KdView {
   Box3f bounds;
   const LeafIntersector* exact_leaf = nullptr;  ///< exact-decision leaf test, or null = watertight float
 };
+
+inline namespace BSPRT_ISA_NAMESPACE {  // compiled into per-ISA kernels too (simd.h, ODR)
+
+/// The exact leaf test on leaf entries [first, end) for one ray, four
+/// triangles at a time: their corners (stored by triangle number) gathered
+/// into leaf order, the float prefilter (exact_prefilter.h; when `filter`)
+/// leaving out the certain misses, one call for the rest. The nearest hit and
+/// its tie rule do not depend on how the triangles are grouped, so the answer
+/// is the one-at-a-time answer; left-out triangles still count as tests.
+inline void kd_exact_leaf(const KdView& v, std::uint32_t first, std::uint32_t end, const Ray& ray,
+                          const WatertightRay& wr, bool filter, NearestHit& nearest, RayCounters* c) {
+  for (std::uint32_t i = first; i < end; i += 4) {
+    const std::uint32_t n = end - i < 4 ? end - i : 4;
+    float rows[36] = {};  // nine rows of n, read four floats at a time: 8 n + 4 <= 36
+    for (std::uint32_t j = 0; j < n; ++j) {
+      const LeafTriangle& t = v.triangles[v.prims[i + j]];
+      for (int k = 0; k < 9; ++k) rows[std::uint32_t(k) * n + j] = t.v[k / 3][k % 3];
+    }
+    const unsigned lanes = filter ? exact_lanes(wr, rows, n) : (1u << n) - 1u;
+    std::uint32_t prims[4];
+    LeafTriangle corners[4];
+    std::uint32_t m = 0;
+    for (unsigned bits = lanes; bits != 0; bits &= bits - 1, ++m) {
+      const std::uint32_t j = std::uint32_t(__builtin_ctz(bits));
+      prims[m] = v.prims[i + j];
+      corners[m] = v.triangles[prims[m]];
+    }
+    if (c) c->triangle_tests += n - m;
+    if (m) v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(prims, m), corners, nearest, c);
+  }
+}
+
+}  // namespace BSPRT_ISA_NAMESPACE
 
 /// Single-ray trace used by kernels for incoherent packets.
 using KdSingleFn = Hit (*)(const KdView& view, const Ray& ray, RayCounters* counters);

@@ -73,9 +73,8 @@ inline void packet_exact_leaf(const KdView& v, const KdNode& n, const Ray* rays,
   store<W>(t, hit.t);
   for (unsigned m = movemask<W>(active); m != 0; m &= m - 1) {
     const int lane = std::countr_zero(m);
-    for (std::uint32_t i = first; i < end; ++i)
-      v.exact_leaf->intersect(rays[lane], std::span<const std::uint32_t>(v.prims + i, 1), &v.triangles[v.prims[i]],
-                              nearest[lane], nullptr);
+    const WatertightRay wr = watertight_precompute(rays[lane]);
+    detail::kd_exact_leaf(v, first, end, rays[lane], wr, detail::filterable(wr, rays[lane]), nearest[lane], nullptr);
     t[lane] = cull_bound(nearest[lane]);
   }
   hit.t = load<W>(t);

@@ -47,9 +47,7 @@ inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, con
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if (v.exact_leaf) {
     if constexpr (kCount) ++c->leaf_visits;
-    for (std::uint32_t i = first; i < end; ++i)  // corners by triangle number: one prim per call
-      v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + i, 1), &v.triangles[v.prims[i]], nearest,
-                              kCount ? c : nullptr);
+    detail::kd_exact_leaf(v, first, end, ray, wr, detail::filterable(wr, ray), nearest, kCount ? c : nullptr);
     hit.prim = nearest.hit.prim;
     hit.t = cull_bound(nearest);
     return;
