@@ -25,9 +25,9 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
                  "(every triangle touching the closed cell)")
       ->capture_default_str();
   cmd.add_option("--top-slots", o.top_slots,
-                 "bsp-top: largest BSP subtree (8-byte slots) under one box of the box top")
-      ->check(CLI::Range(1u, 1u << 27))
-      ->capture_default_str();
+                 "bsp-top, bsp-bvh8 (and -float): largest BSP subtree (8-byte slots) under one box of the top "
+                 "(default: 1024 for bsp-top, 1 for bsp-bvh8)")
+      ->check(CLI::Range(1u, 1u << 27));
   cmd.add_option("--single-rays", o.single_rays,
                  "bsp, bsp-float, bsp-zero-eps: how single rays run: auto (interleaved for incoherent rays with tfar = inf), "
                  "sequential or interleaved; the hits are the same")
@@ -89,7 +89,7 @@ std::vector<std::string> ignored_options(const TraceOptions& o) {
   if (o.single_rays != defaults.single_rays && !used.single_rays)
     ignored.push_back("--single-rays (bsp, bsp-float, bsp-zero-eps only)");
   if (o.top_slots != defaults.top_slots && !used.top_slots)
-    ignored.push_back("--top-slots (bsp-top, bsp-top-float only)");
+    ignored.push_back("--top-slots (bsp-top, bsp-top-float, bsp-bvh8, bsp-bvh8-float only)");
   if (o.membership != defaults.membership && !used.membership)
     ignored.push_back(o.tree.empty() ? "--membership (BSP accelerators only)"
                                      : "--membership (a BSP built in memory only; the tree file fixed it when it was "

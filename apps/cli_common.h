@@ -24,7 +24,7 @@ struct TraceOptions {
   int packets = 1;
   bool allow_nonfinite = false;
   std::string membership = "area";
-  std::uint32_t top_slots = 1024;
+  std::uint32_t top_slots = 0;  ///< 0: the accelerator's default (AccelOptions::top_slots)
   std::string single_rays = "auto";
 };
 

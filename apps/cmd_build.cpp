@@ -191,6 +191,10 @@ void register_build(CLI::App& app) {
   cmd->add_option("--min-gain", args->costs.min_gain,
                   "bsp: least expected triangle tests per ray a split must save (docs/bsp-build.md)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--min-gain-triangles", args->costs.min_gain_triangles,
+                  "bsp: --min-gain limits every split of a node of at most this many triangles, in larger nodes only "
+                  "splits that keep all of them in one child (docs/bsp-build.md)")
+      ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
   cmd->callback([args] { run_build(*args); });

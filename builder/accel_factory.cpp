@@ -74,12 +74,22 @@ class ExactLeafTracer final : public Accelerator {
   Tracer tracer_;
 };
 
-/// bsp or bsp-top: the BSP with exact leaves; top_slots > 0 puts it under a box top.
-std::unique_ptr<Accelerator> make_exact_bsp(const TriangleSoup& soup, FlatBspTree flat, std::uint32_t top_slots,
-                                            BspSingleRays single_rays) {
+/// Which top a BSP mode puts over its tree.
+enum class BspTop { None, Box4, Bvh8 };
+
+/// `slots` 0 takes the top's default (AccelOptions::top_slots): the largest
+/// subtree that measured fastest on bunny random rays (cachegrind, docs/bvh8.md).
+void add_top(BspTracer& t, BspTop top, std::uint32_t slots) {
+  if (top == BspTop::Box4) add_box_top(t, slots ? slots : 1024);
+  if (top == BspTop::Bvh8) add_bvh8_top(t, slots ? slots : 1);
+}
+
+/// bsp, bsp-top or bsp-bvh8: the BSP with exact leaves, under `top` of subtrees of at most `slots` slots.
+std::unique_ptr<Accelerator> make_exact_bsp(const TriangleSoup& soup, FlatBspTree flat, BspTop top,
+                                            std::uint32_t slots, BspSingleRays single_rays) {
   auto t = std::make_unique<ExactLeafTracer<BspTracer>>(soup, std::move(flat), soup, BspEpsilon::Certified);
   t->tracer().set_single_rays(single_rays);
-  if (top_slots > 0) add_box_top(t->tracer(), top_slots);
+  add_top(t->tracer(), top, slots);
   return t;
 }
 
@@ -150,7 +160,7 @@ constexpr AccelInfo kTable[] = {
     {"bsp", "exact BSP, certified traversal, exact-decision leaf test (the default)", A::Bsp, true, true, false,
      false, true, false,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return make_exact_bsp(s, load_or_build_bsp(s, o), 0, o.single_rays);
+       return make_exact_bsp(s, load_or_build_bsp(s, o), BspTop::None, 0, o.single_rays);
      }},
     {"bsp-float", "exact BSP, certified float traversal, float watertight leaf test", A::Bsp, false, true, false,
      false, true, false,
@@ -160,13 +170,24 @@ constexpr AccelInfo kTable[] = {
     {"bsp-top-float", "bsp-top with the float watertight leaf test", A::Bsp, false, false, false, false, false, true,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
        auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(s, o), s, BspEpsilon::Certified);
-       add_box_top(*bsp, o.top_slots);
+       add_top(*bsp, BspTop::Box4, o.top_slots);
+       return bsp;
+     }},
+    {"bsp-bvh8", "the BSP under an 8-wide BVH over its pieces (the bvh8 kernel), single rays, exact-decision leaf test",
+     A::Bsp, true, false, false, false, false, true,
+     [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
+       return make_exact_bsp(s, load_or_build_bsp(s, o), BspTop::Bvh8, o.top_slots, BspSingleRays::Auto);
+     }},
+    {"bsp-bvh8-float", "bsp-bvh8 with the float watertight leaf test", A::Bsp, false, false, false, false, false, true,
+     [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
+       auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(s, o), s, BspEpsilon::Certified);
+       add_top(*bsp, BspTop::Bvh8, o.top_slots);
        return bsp;
      }},
     {"bsp-top", "the BSP under a 4-wide box top, single rays, exact-decision leaf test", A::Bsp, true, false, false,
      false, false, true,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return make_exact_bsp(s, load_or_build_bsp(s, o), o.top_slots, BspSingleRays::Auto);
+       return make_exact_bsp(s, load_or_build_bsp(s, o), BspTop::Box4, o.top_slots, BspSingleRays::Auto);
      }},
     {"bvh8", "plain 8-wide BVH (Embree's SAH builder), Embree-style single-ray kernel, exact-decision leaf test",
      A::None, true, false, false, false, false, false,

@@ -32,9 +32,11 @@ struct AccelOptions {
   /// Called with (done, total) during long builds (the CLI draws a bar).
   std::function<void(double, double)> progress;
   BspConfig bsp;          ///< settings of an in-memory BSP build
-  /// bsp-top, bsp-top-certified: largest BSP subtree (in 8-byte slots) under
-  /// one box of the box top (traverse/bsp_boxtop.h).
-  std::uint32_t top_slots = 1024;
+  /// bsp-top, bsp-bvh8 and their -float forms: largest BSP subtree (in 8-byte
+  /// slots) under one box of the top (traverse/bsp/bsp_boxtop.h); 0 takes the
+  /// top's default, 1024 for bsp-top, 1 for bsp-bvh8 (each leaf cell its own
+  /// piece; pieces of at most four triangles become triangle leaves).
+  std::uint32_t top_slots = 0;
   /// bsp, bsp-zero-eps: how batches of single rays run (traverse/bsp_traverse.h).
   BspSingleRays single_rays = BspSingleRays::Auto;
 

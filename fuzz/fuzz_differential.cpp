@@ -5,8 +5,9 @@
 // special (a direction component ±0, subnormal, huge, infinite or NaN; the
 // direction scaled by 2^-100 or 2^100; a segment starting behind the origin).
 // Builds brute, kd, bvh8, bvh8-float, bsp-float, bsp (exact leaves), bsp-top-float
-// and bsp-top (box tops over one-slot subtrees) and the exact reference and traps when
-//   - kd, bvh8, bsp or bsp-top (exact leaves) differ from the exact reference (lost,
+// and bsp-top (box tops over one-slot subtrees), bsp-bvh8 (BVH8 tops over pieces of
+// one and of eight slots) and the exact reference and traps when
+//   - kd, bvh8, bsp, bsp-top or bsp-bvh8 (exact leaves) differ from the exact reference (lost,
 //     extra, farther or nearer; a tie on another triangle at the same t is
 //     allowed), or
 //   - kd, bsp or bsp-top differ from brute force beyond ties: all run the same
@@ -16,7 +17,7 @@
 //     tree's single rays in any bit of any hit or in any counter: the packet
 //     kernels promise the single-ray sequence of nodes and leaves per lane, or
 //   - bvh8-float's plain x86-64 kernel differs from its AVX2 or AVX-512 kernel in any bit.
-// (bvh8-float is not compared with brute force: its boxes are exact, so a
+// (bvh8-float and bsp-bvh8-float are not compared with brute force: their boxes are exact, so a
 // float hit on a triangle whose box the exact ray just misses is not found;
 // docs/bvh8.md.)
 #include <cstdint>
@@ -205,6 +206,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   expect_agree("bsp-top-float vs brute", brute, trace(*make("bsp-top-float", soup, 1), rays));
   expect_agree("kd vs exact", exact, trace(*make("kd", soup), rays));
   expect_agree("bvh8 vs exact", exact, trace(*make("bvh8", soup), rays));
+  expect_agree("bsp-bvh8 vs exact", exact, trace(*make("bsp-bvh8", soup, 1), rays));
+  expect_agree("bsp-bvh8 (8 slots) vs exact", exact, trace(*make("bsp-bvh8", soup, 8), rays));
   expect_bvh8_kernels_equal(*make("bvh8-float", soup), rays);
   expect_packets_equal("kd", *make("kd", soup), rays);  // exact leaves in the packet kernels
   const auto kd = make("kd-float", soup), bsp = make("bsp-float", soup);

@@ -7,7 +7,7 @@
 # docs/notes/2026-12-01-speed-targets.md quotes this table.
 #   scripts/ray_profile.sh                           # bunny, 100000 rays per set
 #   scripts/ray_profile.sh path/to/mesh.ply 50000    # another mesh, fewer rays
-#   MODES="kd bsp:interleaved" RAYSETS=random BSPRT_BUILD_DIR=dir BSPRT_SKIP_DEPS=1 scripts/ray_profile.sh
+#   MODES="kd bsp:interleaved bsp-bvh8@16" RAYSETS=random BSPRT_BUILD_DIR=dir BSPRT_SKIP_DEPS=1 scripts/ray_profile.sh
 # Run by hand (not in CI): about a minute per mode and ray set on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,7 +15,7 @@ ROOT=$(pwd)
 SCENE=${1:-$ROOT/../shared/scenes/stanford-bunny.obj}
 N=${2:-100000}
 BUILD=${BSPRT_BUILD_DIR:-build}
-MODES=${MODES:-"kd bsp bsp:sequential bsp-top bvh8-float bvh8 embree"}
+MODES=${MODES:-"kd bsp bsp:sequential bsp-top bsp-bvh8 bvh8-float bvh8 embree"}
 RAYSETS=${RAYSETS:-"primary random"}
 
 [ -n "${BSPRT_SKIP_DEPS:-}" ] || scripts/install-deps.sh
@@ -47,9 +47,10 @@ for set in $RAYSETS; do
   fi
 done
 
-# One cachegrind run: mode (accel[:single-rays]), ray file, output tag.
+# One cachegrind run: mode (accel[:single-rays][@top-slots]), ray file, output tag.
 profile() {
-  local mode=$1 rays=$2 tag=$3 accel=${1%%:*} extra=()
+  local mode=${1%%@*} rays=$2 tag=$3 accel=${1%%[:@]*} extra=()
+  [[ "$1" == *@* ]] && extra+=(--top-slots "${1#*@}")
   [[ "$mode" == *:* ]] && extra+=(--single-rays "${mode#*:}")
   case "$accel" in
     kd) extra+=(--tree "$work/tree.kd") ;;
@@ -68,7 +69,7 @@ echo "|---|---|---:|---:|---:|"
 for set in $RAYSETS; do
   n=$(count "$work/$set.rays")
   for mode in $MODES; do
-    tag="$set-${mode//:/-}"
+    tag="$set-${mode//[:@]/-}"
     profile "$mode" "$work/$set.rays" "$tag" &
     profile "$mode" "$work/$set-1.rays" "$tag-1" &
     wait

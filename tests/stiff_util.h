@@ -24,8 +24,8 @@ namespace bsprt::test {
 
 /// Every tracer of one scene, made from the accelerator table; `soup` must outlive it.
 struct ModeSet {
-  /// kd-float, kd, bvh8-float, bvh8 and bsp (exact leaves), bsp-float, bsp-top and bsp-top-float (box tops over
-  /// 8-slot subtrees: many boxes even on small scenes) (+ embree when asked);
+  /// kd-float, kd, bvh8-float, bvh8 and bsp (exact leaves), bsp-float, bsp-top and bsp-top-float, bsp-bvh8 and
+  /// bsp-bvh8-float (tops over 8-slot subtrees: many boxes even on small scenes) (+ embree when asked);
   /// the BSP modes share one build, handed to them as an in-memory tree file.
   std::vector<std::unique_ptr<Accelerator>> modes;
   std::unique_ptr<Accelerator> exact;
@@ -42,7 +42,7 @@ struct ModeSet {
     bsp.tree_file = std::make_shared<const TreeFileReader>(
         "(test: in-memory tree)", bsp_tree_file(soup, tree, flatten_bsp(soup, tree)).bytes());
     bsp.top_slots = 8;
-    for (const char* mode : {"bsp-float", "bsp", "bsp-top-float", "bsp-top"})
+    for (const char* mode : {"bsp-float", "bsp", "bsp-top-float", "bsp-top", "bsp-bvh8-float", "bsp-bvh8"})
       modes.push_back(make_tracer(mode, soup, bsp));
     if (with_embree) modes.push_back(make_tracer("embree", soup));
     if (std::getenv("BSPRT_STIFF_BRUTE")) modes.push_back(make_tracer("brute-certified", soup));

@@ -432,3 +432,38 @@ TEST_CASE("bsp: progress reaches the total, report adds up", "[bsp]") {
   CHECK(refs == t.triangle_refs().size());
   CHECK(check_leaves(s, t) == "");
 }
+
+namespace {
+/// The most triangles any leaf of `t` lists.
+std::size_t largest_leaf(const BspTree& t) {
+  std::size_t most = 0;
+  for (std::uint32_t i = 0; i < t.nodes().size(); ++i)
+    if (t.nodes()[i].is_leaf()) most = std::max(most, t.leaf_triangles(i).size());
+  return most;
+}
+}  // namespace
+
+TEST_CASE("bsp: a small dense cluster in a large scene is split (regression: conference's 1,696-triangle leaves)",
+          "[bsp]") {
+  // A floor and a wall 1000 across, and a sphere of 0.01 radius (960 triangles) on the floor: the
+  // uniform-ray gain of splitting the sphere is below min_gain, as for conference's chair fittings.
+  TriangleSoup s;
+  add_tri(s, {-500, 0, -500}, {500, 0, -500}, {500, 0, 500});
+  add_tri(s, {-500, 0, -500}, {500, 0, 500}, {-500, 0, 500});
+  add_tri(s, {-500, 0, -500}, {500, 0, -500}, {500, 800, -500});
+  add_tri(s, {-500, 0, -500}, {500, 800, -500}, {-500, 800, -500});
+  const TriangleSoup ball = uv_sphere(16, 32);
+  for (std::size_t i = 0; i < ball.size(); ++i) {
+    const auto at = [&](int k) { return ball.vertices[ball.triangles[i][k]] * 0.01f + Vec3f(3.0f, 0.01f, 7.0f); };
+    add_tri(s, at(0), at(1), at(2));
+  }
+  BspConfig c;
+  c.threads = 1;
+  const BspTree now = build_bsp(s, c);
+  REQUIRE_NOTHROW(now.validate(s.size(), &s));
+  c.min_gain_triangles = SIZE_MAX;  // the rule before 2026-12-03: min_gain on every split
+  const BspTree before = build_bsp(s, c);
+  INFO("largest leaf: " << largest_leaf(now) << " triangles, with the old rule " << largest_leaf(before));
+  CHECK(largest_leaf(before) > 200);  // the old rule keeps the sphere (nearly) whole
+  CHECK(largest_leaf(now) <= 32);
+}

@@ -271,6 +271,8 @@ TEST_CASE("an option the chosen accelerator would ignore is a usage error", "[cl
                         Case{"--accel embree --single-rays sequential", "does not use --single-rays"},
                         Case{"--accel bsp --top-slots 4", "does not use --top-slots"},
                         Case{"--accel kd --top-slots 4", "does not use --top-slots"},
+                        // Its default depends on the top (1024 for bsp-top, 1 for bsp-bvh8): given at all, it is used.
+                        Case{"--accel embree --top-slots 1024", "does not use --top-slots"},
                         Case{"--accel kd --membership closed", "does not use --membership"},
                         Case{"--accel bsp --tree " + tree + " --membership closed", "tree file fixed it"},
                         Case{"--accel brute --single-rays interleaved --top-slots 8",
@@ -285,7 +287,8 @@ TEST_CASE("an option the chosen accelerator would ignore is a usage error", "[cl
   for (const std::string& ok :
        {std::string("--accel bsp --single-rays interleaved"), std::string("--accel bsp-zero-eps --single-rays sequential"),
         std::string("--accel bsp-top --top-slots 4"), std::string("--accel bsp-top-float --top-slots 4"),
-        std::string("--accel bsp --membership closed"), std::string("--accel embree --single-rays auto --top-slots 1024 --membership area")}) {
+        std::string("--accel bsp-bvh8 --top-slots 4"), std::string("--accel bsp-bvh8-float --top-slots 1"),
+        std::string("--accel bsp --membership closed"), std::string("--accel embree --single-rays auto --membership area")}) {
     const Run r = trace(ok);
     INFO(ok << "\n" << r.output);
     CHECK(r.status == 0);

@@ -67,10 +67,14 @@ class Builder {
   }
 
  private:
-  /// The split beats the leaf by at least BspConfig::min_gain (area weighted).
-  bool worth_it(double cost, std::size_t n, double area) const {
+  /// The split beats the leaf; and when one child keeps every triangle (the
+  /// zoom around a shared vertex that the local SAH never stops), by at least
+  /// BspConfig::min_gain (area weighted).
+  bool worth_it(double cost, std::size_t n, double area, bool keeps_all) const {
     const double leaf = cfg_.c_isect * double(n);
-    return cost < leaf && (leaf - cost) / cfg_.c_isect * (area / root_area_) >= cfg_.min_gain;
+    if (!(cost < leaf)) return false;
+    if (!keeps_all && n > cfg_.min_gain_triangles) return true;
+    return (leaf - cost) / cfg_.c_isect * (area / root_area_) >= cfg_.min_gain;
   }
 
   const TriangleSoup& soup_;
@@ -122,7 +126,7 @@ bool Builder::try_split(const Cell& cell, const std::vector<ClippedTriangle>& tr
   }
   bool coplanar_left = true;
   const double cost = sah_cost(cfg_, c.c_trav, count, c.area_left, c.area_right, area, &coplanar_left);
-  if (!worth_it(cost, n, area)) return false;
+  if (!worth_it(cost, n, area, keeps_all(count, n))) return false;
   // Pass 2: clip into the children (a side is only clipped when the other side
   // has vertices strictly beyond the plane).
   for (std::size_t i = 0; i < n; ++i) {
@@ -159,8 +163,14 @@ std::unique_ptr<BuildNode> Builder::build(Cell cell, std::vector<ClippedTriangle
   });
   SplitResult sr;
   const Candidate* chosen = nullptr;
-  for (int k = 0; k < cfg_.max_split_attempts && k < int(cands.size()); ++k) {
-    if (!worth_it(cands[k].cost, n, area)) break;
+  // The cheapest candidates that pass worth_it are tried exactly; one that keeps
+  // every triangle in a child and gains too little (often the empty-space cuts
+  // around a small dense cluster) is passed over without using up an attempt.
+  int attempts = 0;
+  for (std::size_t k = 0; attempts < cfg_.max_split_attempts && k < cands.size(); ++k) {
+    if (!(cands[k].cost < cfg_.c_isect * double(n))) break;  // sorted: no later one beats the leaf
+    if (!worth_it(cands[k].cost, n, area, cands[k].keeps_all)) continue;
+    ++attempts;
     sr = SplitResult{};
     if (try_split(cell, tris, cands[k], area, sr, st)) {
       chosen = &cands[k];

@@ -88,7 +88,7 @@ void kd_axis(const NodeView& v, const BspConfig& cfg, int a, const std::vector<B
     }
     if (al <= kMinAreaFraction * v.area || ar <= kMinAreaFraction * v.area) continue;
     const SplitCount c = kd_count(lo, hi, flat, s, cfg.membership);
-    out.push_back({p, sah_cost(cfg, cfg.c_kd, c, al, ar, v.area), al, ar, cfg.c_kd});
+    out.push_back({p, sah_cost(cfg, cfg.c_kd, c, al, ar, v.area), al, ar, cfg.c_kd, keeps_all(c, v.tris.size())});
   }
 }
 
@@ -183,7 +183,7 @@ void add_bsp_candidates(const RoundingGuard& g, const TriangleSoup& soup, const 
     const double lower = c_trav + cfg.c_isect * double(n) * std::min(al, ar) / v.area;
     if (lower >= cfg.c_isect * double(n)) continue;
     const SplitCount c = bsh.count(g, soup, pp, cfg.membership, stats);
-    out.push_back({p, sah_cost(cfg, c_trav, c, al, ar, v.area), al, ar, c_trav});
+    out.push_back({p, sah_cost(cfg, c_trav, c, al, ar, v.area), al, ar, c_trav, keeps_all(c, n)});
   }
 }
 

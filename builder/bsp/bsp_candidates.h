@@ -25,7 +25,16 @@ struct Candidate {
   double area_left = 0;   ///< approximate surface areas of the two child cells
   double area_right = 0;
   double c_trav = 0;      ///< traversal cost of the node this plane would make
+  /// By the (conservative) counts, one child would list every triangle of the
+  /// node: the only kind of split BspConfig::min_gain limits.
+  bool keeps_all = false;
 };
+
+/// Whether a split with counts `c` of a node of `n` triangles leaves one child
+/// with all of them (coplanar triangles counted on both sides).
+inline bool keeps_all(const SplitCount& c, std::size_t n) {
+  return c.left + c.both + c.coplanar >= n || c.right + c.both + c.coplanar >= n;
+}
 
 /// What the candidate evaluation needs to know about a node.
 struct NodeView {

@@ -3,14 +3,42 @@
 #include "traverse/bsp/bsp_boxtop.h"
 
 #include <algorithm>
+#include <limits>
 
 namespace bsprt {
 namespace {
+
+/// Distinct triangles (by number) of a subtree's leaf lists, with an early exit.
+struct Distinct {
+  const CompactBspTree& tree;
+  std::span<const std::uint32_t> prims;
+  std::uint32_t limit;                 ///< stop once more than this many are found
+  std::vector<std::uint32_t> entries;  ///< first entry of each distinct triangle
+
+  /// False once more than `limit` distinct triangles are found.
+  bool collect(std::uint32_t i) {
+    const CompactBspSlot& n = tree.slots[i];
+    if (n.is_leaf()) {
+      for (std::uint32_t j = n.prim_offset(), e = j + n.prim_count(); j < e; ++j) {
+        bool seen = false;
+        for (const std::uint32_t k : entries) seen = seen || prims[k] == prims[j];
+        if (seen) continue;
+        if (entries.size() == limit) return false;
+        entries.push_back(j);
+      }
+      return true;
+    }
+    if (!n.first_empty() && !collect(i + n.slots())) return false;
+    return n.second_empty() || collect(n.second_child());
+  }
+};
 
 struct Cutter {
   const CompactBspTree& tree;
   std::span<const BspTriangle> triangles;
   std::uint32_t max_slots;
+  std::span<const std::uint32_t> prims;
+  std::uint32_t max_triangles;
   std::vector<std::uint32_t> size;  ///< slots of the subtree at each node slot
   std::vector<BspSubtreeBox> out;
 
@@ -56,6 +84,15 @@ struct Cutter {
 
   void cut(std::uint32_t i, const Box3f& cell) {
     const CompactBspSlot& n = tree.slots[i];
+    if (max_triangles > 0) {
+      Distinct d{tree, prims, max_triangles, {}};
+      if (d.collect(i)) {
+        Box3f box;
+        gather(i, cell, box);
+        if (!box.empty()) out.push_back({i, box, std::uint32_t(d.entries.size())});
+        return;
+      }
+    }
     if (n.is_leaf() || size[i] <= max_slots) {
       Box3f box;
       gather(i, cell, box);
@@ -72,12 +109,21 @@ struct Cutter {
 }  // namespace
 
 std::vector<BspSubtreeBox> bsp_subtree_boxes(const CompactBspTree& tree, std::span<const BspTriangle> triangles,
-                                             const Box3f& bounds, std::uint32_t max_slots) {
+                                             const Box3f& bounds, std::uint32_t max_slots,
+                                             std::span<const std::uint32_t> prims, std::uint32_t max_triangles) {
   if (tree.slots.empty() || bounds.empty()) return {};
-  Cutter c{tree, triangles, max_slots, std::vector<std::uint32_t>(tree.slots.size(), 0), {}};
+  if (prims.size() != triangles.size()) max_triangles = 0;  // no triangle numbers: the size rule only
+  Cutter c{tree, triangles, max_slots, prims, max_triangles, std::vector<std::uint32_t>(tree.slots.size(), 0), {}};
   c.measure(0);
   c.cut(0, bounds);
   return std::move(c.out);
+}
+
+std::vector<std::uint32_t> bsp_subtree_entries(const CompactBspTree& tree, std::span<const std::uint32_t> prims,
+                                               std::uint32_t slot) {
+  Distinct d{tree, prims, std::numeric_limits<std::uint32_t>::max(), {}};
+  d.collect(slot);
+  return std::move(d.entries);
 }
 
 }  // namespace bsprt

@@ -49,6 +49,9 @@ struct BoxTop {
 struct BspSubtreeBox {
   std::uint32_t slot;  ///< root slot of the subtree in the compact tree
   Box3f box;           ///< holds every point where a listed triangle meets a leaf cell of the subtree
+  /// Cut by the small-subtree rule (bsp_subtree_boxes' max_triangles): the
+  /// number of distinct triangles its leaves list; 0 when cut by size.
+  std::uint32_t triangles = 0;
 };
 
 /// Cuts the compact tree into the largest subtrees of at most `max_slots`
@@ -56,7 +59,19 @@ struct BspSubtreeBox {
 /// file comment). `triangles[i]` holds the corners of leaf-list entry i.
 /// Subtrees whose box is empty (no listed triangle meets its kd box) are left
 /// out: no ray can hit anything in them.
+///
+/// With `max_triangles` > 0 (and `prims`, the leaf lists' triangle numbers),
+/// a subtree whose leaves list at most that many distinct triangles is cut
+/// there too, however many slots it has, and records their number: a caller
+/// may test them directly instead of walking the subtree (the BVH8 top does).
 std::vector<BspSubtreeBox> bsp_subtree_boxes(const CompactBspTree& tree, std::span<const BspTriangle> triangles,
-                                             const Box3f& bounds, std::uint32_t max_slots);
+                                             const Box3f& bounds, std::uint32_t max_slots,
+                                             std::span<const std::uint32_t> prims = {},
+                                             std::uint32_t max_triangles = 0);
+
+/// The leaf-list entries of the subtree at `slot`, the first entry of each
+/// distinct triangle (by `prims`), in depth-first order.
+std::vector<std::uint32_t> bsp_subtree_entries(const CompactBspTree& tree, std::span<const std::uint32_t> prims,
+                                               std::uint32_t slot);
 
 }  // namespace bsprt

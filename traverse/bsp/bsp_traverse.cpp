@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <limits>
 #include <stdexcept>
@@ -240,6 +241,70 @@ Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCoun
   });
 }
 
+/// One ray's state for the BVH8 top's subtree callback (bvh8_kernel.h); the
+/// BSP's constants are made at the first subtree the ray enters (most random
+/// rays enter none).
+struct WideRay {
+  const BspView* v;
+  const Ray* ray;
+  const Bvh8Subtree* subtrees;
+  bool set_up = false;
+  bool sheared = false;
+  BspRayConst rc;
+  WatertightRay wr;  ///< made at the first float leaf test
+};
+
+/// Subtree `index` under the BVH8 top: the ray's interval clipped to the
+/// subtree's certified box by widened slab crossings, exactly as walk_top
+/// clips (the kernel's own box test proves only that the box is entered, not
+/// where), and to the nearest hit so far; then the certified BSP steps.
+template <bool kCount>
+void wide_subtree(WideRay& w, std::uint32_t index, Hit& hit, NearestHit& nearest, RayCounters* c) {
+  if (!w.set_up) w.rc = detail::bsp_ray_setup(*w.ray, w.v->bounds, w.v->certified), w.set_up = true;
+  const BspRayConst& rc = w.rc;
+  if (!rc.live) return;  // the ray misses the root cell: no subtree can hit
+  const Box3f& box = w.subtrees[index].box;
+  const float inf = std::numeric_limits<float>::infinity();
+  float enter = -inf, exit = inf;
+  for (int k = 0; k < 3; ++k) {
+    const float lo = (box.lo[k] - rc.o[k]) * rc.inv[k], hi = (box.hi[k] - rc.o[k]) * rc.inv[k];
+    const float e = rc.neg[k] ? hi : lo, x = rc.neg[k] ? lo : hi;
+    enter = e > enter ? e : enter;  // NaN crossings do not clip
+    exit = x < exit ? x : exit;
+  }
+  Hit local;  // exact leaves: the answer is in nearest; local carries its cull bound
+  const bool exact = w.v->exact_leaf != nullptr;
+  if (exact) local.t = cull_bound(nearest);
+  Hit& h = exact ? local : hit;
+  const float best = detail::hit_bound(rc, h.t);
+  enter = detail::widen_dn(enter);
+  exit = detail::widen_up(exit);
+  const float tmin = enter > rc.tmin ? enter : rc.tmin;
+  float tmax = exit < rc.tmax ? exit : rc.tmax;
+  tmax = tmax < best ? tmax : best;
+  if (!(tmin <= tmax)) return;
+  if (!exact && !w.sheared) w.wr = watertight_precompute(*w.ray), w.sheared = true;
+  traverse_subtree<kCount>(*w.v, rc, *w.ray, w.wr, w.subtrees[index].slot, tmin, tmax, h, nearest, c);
+}
+
+void wide_subtree_call(void* ctx, std::uint32_t index, Hit& hit, NearestHit& nearest, RayCounters* c) {
+  WideRay& w = *static_cast<WideRay*>(ctx);
+  if (c)
+    wide_subtree<true>(w, index, hit, nearest, c);
+  else
+    wide_subtree<false>(w, index, hit, nearest, nullptr);
+}
+
+/// Whether the BVH8 kernel can take the ray: |o| <= 2^126, so that p - o
+/// stays finite (Bvh8Tracer's own limit). A scaled or unsafe ray
+/// (bsp_kernel.h) is fine: the subtree clip and steps run in the BSP's
+/// parameter, as in walk_top, and compare hits through hit_bound.
+inline bool wide_takes(const Ray& ray) {
+  for (int k = 0; k < 3; ++k)
+    if (!(std::fabs(ray.org[k]) <= 0x1p126f)) return false;
+  return true;
+}
+
 /// Bit of CompactBspSlot::kFirstEmpty; kSecondEmpty is the next one.
 constexpr unsigned kFirstBit = unsigned(std::countr_zero(CompactBspSlot::kFirstEmpty));
 static_assert(CompactBspSlot::kSecondEmpty == CompactBspSlot::kFirstEmpty << 1);
@@ -426,6 +491,10 @@ Hit BspTracer::trace(const Ray& ray, RayCounters* counters) const {
     if (counters) ++counters->rays;
     return Hit{};
   }
+  if (wide_ && wide_safe_scene_ && wide_takes(ray)) {
+    WideRay w{&v, &ray, wide_->tree().subtrees.data()};
+    return wide_->trace_with(ray, wide_subtree_call, &w, counters);
+  }
   if (has_top_) {
     if (top_.nodes.empty()) {
       if (counters) ++counters->rays;
@@ -443,8 +512,8 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
   // Box tops trace single rays, and so do exact leaves when counted (the
   // packet kernels count no exact decisions; the counts are the same).
-  if (need == Isa::Scalar || tree_.bounds.empty() || (exact_leaf_ && counters) || has_top_) {
-    const bool interleave = !counters && !has_top_ && !tree_.bounds.empty() &&
+  if (need == Isa::Scalar || tree_.bounds.empty() || (exact_leaf_ && counters) || has_top_ || wide_) {
+    const bool interleave = !counters && !has_top_ && !wide_ && !tree_.bounds.empty() &&
                             (single_rays_ == BspSingleRays::Interleaved ||
                              (single_rays_ == BspSingleRays::Auto && !rays_look_coherent(rays) &&
                               rays_unbounded(rays)));
@@ -469,8 +538,32 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   }
 }
 
-std::vector<BspSubtreeBox> BspTracer::subtree_boxes(std::uint32_t max_slots) const {
-  return bsp_subtree_boxes(compact_, triangles_, tree_.bounds, max_slots);
+std::vector<BspSubtreeBox> BspTracer::subtree_boxes(std::uint32_t max_slots, std::uint32_t max_triangles) const {
+  return bsp_subtree_boxes(compact_, triangles_, tree_.bounds, max_slots, tree_.prims, max_triangles);
+}
+
+bool BspTracer::occluded(const Ray& ray, RayCounters* counters) const {
+  if (wide_ && wide_safe_scene_ && !tree_.bounds.empty() && wide_takes(ray)) {
+    const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
+    WideRay w{&v, &ray, wide_->tree().subtrees.data()};
+    return wide_->occluded_with(ray, wide_subtree_call, &w, counters);
+  }
+  return trace(ray, counters).hit();
+}
+
+void BspTracer::set_bvh8_top(Bvh8Tree top) {
+  if (!top.over_bsp) throw UsageError("bsp: a BVH8 top must be built over the BSP (Bvh8Tree::over_bsp)");
+  for (const Bvh8Subtree& s : top.subtrees)
+    if (s.slot >= compact_.slots.size())
+      throw UsageError("bsp: BVH8 top names slot " + std::to_string(s.slot) + " of a tree of " +
+                       std::to_string(compact_.slots.size()));
+  wide_ = std::make_unique<Bvh8Tracer>(std::move(top));
+  wide_->set_exact_leaf(exact_leaf_);
+  // |p - o| stays finite in the BVH8 kernel for |o| <= 2^64 (safe rays) and corners within 2^126.
+  wide_safe_scene_ = true;
+  for (int k = 0; k < 3; ++k)
+    wide_safe_scene_ = wide_safe_scene_ && std::fabs(tree_.bounds.lo[k]) <= 0x1p126f &&
+                       std::fabs(tree_.bounds.hi[k]) <= 0x1p126f;
 }
 
 void BspTracer::set_box_top(BoxTop top) {
@@ -479,7 +572,8 @@ void BspTracer::set_box_top(BoxTop top) {
 }
 
 std::size_t BspTracer::memory_bytes() const {
-  return top_.nodes.size() * sizeof(BoxTopNode) + compact_.slots.size() * sizeof(CompactBspSlot) +
+  return (wide_ ? wide_->memory_bytes() : 0) + top_.nodes.size() * sizeof(BoxTopNode) +
+         compact_.slots.size() * sizeof(CompactBspSlot) +
          tree_.prims.size() * sizeof(std::uint32_t) + triangles_.size() * sizeof(BspTriangle);
 }
 

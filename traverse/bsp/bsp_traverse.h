@@ -10,6 +10,7 @@
 /// rounding and widen, never trust a float comparison near the plane. Leaves
 /// use the watertight test (watertight.h).
 
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "traverse/bsp/bsp_boxtop.h"
 #include "traverse/bsp/bsp_compact.h"
 #include "traverse/bsp/bsp_node.h"
+#include "traverse/bvh/bvh8_traverse.h"
 #include "traverse/leaf_intersector.h"
 #include "traverse/accelerator.h"
 
@@ -72,15 +74,20 @@ class BspTracer final : public Accelerator {
 
   /// bsp (exact leaves), bsp-float, bsp-zero-eps; with a box top bsp-top,
   /// bsp-top-float, bsp-top-zero-eps.
+  /// With a BVH8 top bsp-bvh8, bsp-bvh8-float, bsp-bvh8-zero-eps.
   std::string name() const override {
     const std::string base = exact_leaf_ ? "bsp" : (mode_ == BspEpsilon::Zero ? "bsp-zero-eps" : "bsp-float");
+    if (wide_) return "bsp-bvh8" + base.substr(3);
     return has_top_ ? "bsp-top" + base.substr(3) : base;
   }
   /// Tests leaves with `exact` (exact decisions, robust/certified_intersector.h)
   /// instead of the float watertight test; it must outlive the tracer. With
   /// certified epsilons this makes every decision exact: the nearest hit equals
   /// the exact reference's. Packets run the exact test lane by lane.
-  void set_exact_leaf(const LeafIntersector* exact) { exact_leaf_ = exact; }
+  void set_exact_leaf(const LeafIntersector* exact) {
+    exact_leaf_ = exact;
+    if (wide_) wide_->set_exact_leaf(exact);
+  }
   /// Single ray, front to back; counts bsp_node_visits, kd_node_visits,
   /// leaf_visits, triangle_tests and rays when `counters` is non-null.
   Hit trace(const Ray& ray, RayCounters* counters = nullptr) const override;
@@ -96,11 +103,40 @@ class BspTracer final : public Accelerator {
                    RayCounters* counters = nullptr) const override;
   /// The tree cut into subtrees of at most `max_slots` slots, with their
   /// certified boxes (bsp_boxtop.h), to build a box top from.
-  std::vector<BspSubtreeBox> subtree_boxes(std::uint32_t max_slots) const;
+  /// With max_triangles > 0, subtrees listing at most that many distinct
+  /// triangles are cut too (bsp_subtree_boxes).
+  std::vector<BspSubtreeBox> subtree_boxes(std::uint32_t max_slots, std::uint32_t max_triangles = 0) const;
   /// Traces single rays through `top` (built from subtree_boxes()) before the
   /// BSP subtrees; packets then run as single rays.
   void set_box_top(BoxTop top);
   bool has_box_top() const { return has_top_; }
+  /// Traces single rays through `top`, a BVH8 over pieces of this tree
+  /// (Bvh8Tree::over_bsp, built by traverse/embree/bvh8_build.h from
+  /// subtree_boxes()), with Bvh8Tracer's kernel; its kSubtree leaves run the
+  /// certified BSP steps from the subtree's root, inside the subtree's box
+  /// (issue #26 step two, docs/bvh8.md). Rays the BSP scales or finds unsafe
+  /// (bsp_kernel.h) take the plain BSP traversal. Packets run as single rays.
+  /// Throws UsageError when `top` fails validation or names a slot that is
+  /// not in the tree.
+  void set_bvh8_top(Bvh8Tree top);
+  bool has_bvh8_top() const { return wide_ != nullptr; }
+  const Bvh8Tracer* bvh8_top() const { return wide_.get(); }
+  /// The BVH8 top's kernel ISA (Bvh8Tracer::set_kernel_isa); tests compare them.
+  void set_bvh8_kernel_isa(Isa isa) {
+    if (wide_) wide_->set_kernel_isa(isa);
+  }
+  /// Test hook: Bvh8Tracer::shrink_boxes_for_testing on the BVH8 top's node boxes.
+  void shrink_bvh8_top_for_testing() {
+    if (wide_) wide_->shrink_boxes_for_testing();
+  }
+  /// Any hit: with a BVH8 top its any-hit kernel, else trace(ray).hit().
+  bool occluded(const Ray& ray, RayCounters* counters = nullptr) const override;
+  /// The leaf lists: triangle numbers and their corners (compact().slots'
+  /// prim_offset indexes both).
+  std::span<const std::uint32_t> leaf_prims() const { return tree_.prims; }
+  std::span<const BspTriangle> leaf_triangles() const { return triangles_; }
+  /// Triangles of the scene the tree was built for.
+  std::uint32_t scene_triangles() const { return std::uint32_t(tree_.triangle_count); }
   /// How trace_batch runs single rays (default Auto); not while tracing.
   void set_single_rays(BspSingleRays how) { single_rays_ = how; }
   BspSingleRays single_rays() const { return single_rays_; }
@@ -120,6 +156,8 @@ class BspTracer final : public Accelerator {
   std::vector<BspTriangle> triangles_;  ///< triangles_[i] = corners of tree_.prims[i]
   BoxTop top_;
   bool has_top_ = false;
+  std::unique_ptr<Bvh8Tracer> wide_;  ///< the BVH8 top, or null
+  bool wide_safe_scene_ = false;      ///< root cell within the BVH8 kernel's range (2^64)
   BspSingleRays single_rays_ = BspSingleRays::Auto;
 };
 

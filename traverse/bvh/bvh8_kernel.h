@@ -14,6 +14,12 @@
 
 namespace bsprt::detail {
 
+/// Traces the ray of `ctx` through BSP subtree `subtree` (a kSubtree
+/// reference, bvh8_node.h): with an exact leaf test into `nearest`, else into
+/// `hit` (bsp_traverse.cpp, BspTracer's BVH8 top). The kernel then lowers its
+/// tfar from the result as after a triangle leaf.
+using Bvh8SubtreeFn = void (*)(void* ctx, std::uint32_t subtree, Hit& hit, NearestHit& nearest, RayCounters* c);
+
 /// Raw pointers into a Bvh8Tracer.
 struct Bvh8View {
   const Bvh8Node* nodes;
@@ -21,6 +27,8 @@ struct Bvh8View {
   const std::uint32_t* prims;
   const LeafTriangle* triangles;       ///< corners of prims[i]
   const LeafIntersector* exact_leaf;   ///< exact-decision leaf test, or null = float watertight
+  Bvh8SubtreeFn subtree = nullptr;     ///< a tree over a BSP: traces its subtrees
+  void* subtree_ctx = nullptr;         ///< the ray's state for `subtree`
 };
 
 /// Traversal stack entries: at most 7 per level of inner nodes, plus one.

@@ -102,9 +102,12 @@ inline std::uint32_t key(float d, unsigned slot) {
 }
 
 /// Prefetches what a reference points to: a node's four lines, or a leaf's
-/// first corners (Embree prefetches every hit child the same way).
+/// first corners (Embree prefetches every hit child the same way); nothing
+/// for a BSP subtree (kSubtrees), whose first node the callback finds.
+template <bool kSubtrees>
 inline void prefetch_ref(const Bvh8View& v, std::uint32_t ref) {
   if (Bvh8Node::is_leaf(ref)) {
+    if (kSubtrees && Bvh8Node::count(ref) == Bvh8Node::kSubtree) return;
     const char* p = reinterpret_cast<const char*>(v.leaf_soa + 9 * std::size_t(Bvh8Node::index(ref)));
     __builtin_prefetch(p);
     __builtin_prefetch(p + 64);
@@ -201,8 +204,10 @@ inline void intersect_leaf(const WatertightRay& r, const float* rows, const std:
   hit.v = w[best] * rcp;
 }
 
-/// kAnyHit: stop at the first hit (occluded); the traversal up to it is the nearest-hit one.
-template <bool kCount, bool kLine, bool kAnyHit>
+/// kAnyHit: stop at the first hit (occluded); the traversal up to it is the
+/// nearest-hit one. kSubtrees: a tree over a BSP, whose kSubtree leaves go to
+/// v.subtree (a separate instance, so the plain tree's leaf step is unchanged).
+template <bool kCount, bool kLine, bool kAnyHit, bool kSubtrees>
 Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
   const Bvh8RayRecip rr = bvh8_reciprocals(ray);
   // The watertight shear, made at the first leaf: most random rays reach none.
@@ -239,7 +244,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       m &= m - 1;
       if (m == 0) {
         ref = n.child[s0];
-        prefetch_ref(v, ref);
+        prefetch_ref<kSubtrees>(v, ref);
         continue;
       }
       const unsigned s1 = unsigned(__builtin_ctz(m));
@@ -247,8 +252,8 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       if (m == 0) {
         const float d0 = lane_of(d, s0), d1 = lane_of(d, s1);
         const bool first = d0 <= d1;
-        prefetch_ref(v, n.child[s0]);
-        prefetch_ref(v, n.child[s1]);
+        prefetch_ref<kSubtrees>(v, n.child[s0]);
+        prefetch_ref<kSubtrees>(v, n.child[s1]);
         stack[sp++] = {n.child[first ? s1 : s0], first ? d1 : d0};
         ref = n.child[first ? s0 : s1];
         continue;
@@ -266,14 +271,26 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       sort_keys_desc(keys, count);
       for (int i = 0; i + 1 < count; ++i) {
         const unsigned s = keys[i] & 7u;
-        prefetch_ref(v, n.child[s]);
+        prefetch_ref<kSubtrees>(v, n.child[s]);
         stack[sp++] = {n.child[s], dist[s]};
       }
       ref = n.child[keys[count - 1] & 7u];
-      prefetch_ref(v, ref);
+      prefetch_ref<kSubtrees>(v, ref);
     }
     {  // a leaf
       const std::uint32_t first = Bvh8Node::index(ref), count = Bvh8Node::count(ref);
+      if (kSubtrees && count == Bvh8Node::kSubtree) {
+        v.subtree(v.subtree_ctx, first, hit, nearest, kCount ? c : nullptr);
+        if (v.exact_leaf) {
+          if (kAnyHit && nearest.hit.hit()) return nearest.hit;
+          const float cull = cull_bound(nearest);
+          tfar = cull < tfar ? cull : tfar;
+        } else {
+          if (kAnyHit && hit.hit()) return hit;
+          tfar = hit.t < tfar ? hit.t : tfar;
+        }
+        goto pop;
+      }
       if constexpr (kCount) ++c->leaf_visits;
       if (v.exact_leaf) {
         // Triangles the float filter proves missed never reach the exact test.
@@ -323,8 +340,11 @@ Hit trace_counted(const Bvh8View& v, const Ray& ray, RayCounters* c) {
   if constexpr (kCount) ++c->rays;
   if (!is_valid(ray)) return Hit{};
   const auto walk = [&] {
-    return ray.tnear >= 0.0f ? trace_kernel<kCount, false, kAnyHit>(v, ray, c)
-                             : trace_kernel<kCount, true, kAnyHit>(v, ray, c);
+    if (v.subtree)
+      return ray.tnear >= 0.0f ? trace_kernel<kCount, false, kAnyHit, true>(v, ray, c)
+                               : trace_kernel<kCount, true, kAnyHit, true>(v, ray, c);
+    return ray.tnear >= 0.0f ? trace_kernel<kCount, false, kAnyHit, false>(v, ray, c)
+                             : trace_kernel<kCount, true, kAnyHit, false>(v, ray, c);
   };
   if constexpr (kCount) {
     const std::uint64_t before = c->exact_decisions;  // set by an exact leaf test

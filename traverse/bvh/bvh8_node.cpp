@@ -39,13 +39,22 @@ bool contains(const Box3f& outer, const Box3f& inner) {
 
 struct Checker {
   const Bvh8Tree& t;
-  std::vector<std::uint8_t> seen_node, seen_prim;
+  std::vector<std::uint8_t> seen_node, seen_prim, seen_subtree;
+  std::uint32_t leaves = 0;
 
   [[noreturn]] static void fail(const std::string& what) { throw std::logic_error("bvh8: " + what); }
 
   void check_ref(std::uint32_t ref, const Box3f& box, std::uint32_t depth) {
     const std::uint32_t i = Bvh8Node::index(ref);
+    if (Bvh8Node::is_leaf(ref) && Bvh8Node::count(ref) == Bvh8Node::kSubtree) {
+      if (!t.over_bsp) fail("subtree reference in a tree over triangles");
+      if (i >= t.subtrees.size()) fail("subtree reference " + std::to_string(i) + " out of range");
+      if (seen_subtree[i]++) fail("subtree " + std::to_string(i) + " referenced twice");
+      if (!contains(box, t.subtrees[i].box)) fail("subtree " + std::to_string(i) + " outside its slot box");
+      return;
+    }
     if (Bvh8Node::is_leaf(ref)) {
+      ++leaves;
       const std::uint32_t n = Bvh8Node::count(ref);
       if (n > Bvh8Node::kMaxLeafSize) fail("leaf at " + std::to_string(i) + " holds more than four triangles");
       if (std::uint64_t(i) + n > t.prims.size()) fail("leaf list " + std::to_string(i) + " out of range");
@@ -53,7 +62,7 @@ struct Checker {
       for (std::uint32_t j = i; j < i + n; ++j) {
         const std::uint32_t p = t.prims[j];
         if (p >= t.scene_triangles) fail("leaf entry " + std::to_string(j) + " names no triangle");
-        if (seen_prim[p]++) fail("triangle " + std::to_string(p) + " in two leaves");
+        if (seen_prim[p]++ && !t.over_bsp) fail("triangle " + std::to_string(p) + " in two leaves");
         for (int c = 0; c < 3; ++c) {
           const Vec3f& q = t.triangles[j].v[c];
           for (int k = 0; k < 3; ++k)
@@ -61,7 +70,7 @@ struct Checker {
               fail("leaf entry " + std::to_string(j) + ": SoA rows and corners differ");
           Box3f b;
           b.extend(q);
-          if (!contains(box, b)) fail("triangle " + std::to_string(p) + " outside its leaf box");
+          if (!t.over_bsp && !contains(box, b)) fail("triangle " + std::to_string(p) + " outside its leaf box");
         }
       }
       return;
@@ -92,13 +101,23 @@ void Bvh8Tree::validate() const {
   if (nodes.empty()) throw std::logic_error("bvh8: no root node");
   if (prims.size() != triangles.size()) throw std::logic_error("bvh8: prims and triangles differ in size");
   if (leaf_soa.size() != 9 * prims.size() + 3) throw std::logic_error("bvh8: leaf_soa is not 9 floats per entry + 3");
-  Checker c{*this, std::vector<std::uint8_t>(nodes.size(), 0), std::vector<std::uint8_t>(scene_triangles, 0)};
+  Checker c{*this, std::vector<std::uint8_t>(nodes.size(), 0), std::vector<std::uint8_t>(scene_triangles, 0),
+            std::vector<std::uint8_t>(subtrees.size(), 0)};
   c.seen_node[0] = 1;
   Box3f all;
   for (int s = 0; s < 8; ++s) all.extend(nodes[0].child_box(s));
   c.check_node(0, all, 1);
   for (std::size_t i = 0; i < nodes.size(); ++i)
     if (!c.seen_node[i]) throw std::logic_error("bvh8: node " + std::to_string(i) + " is not reached");
+  if (over_bsp) {
+    for (std::size_t i = 0; i < subtrees.size(); ++i)
+      if (!c.seen_subtree[i]) throw std::logic_error("bvh8: subtree " + std::to_string(i) + " is not reached");
+    if (c.leaves + subtrees.size() != pieces)
+      throw std::logic_error("bvh8: " + std::to_string(c.leaves + subtrees.size()) + " leaves and subtrees, built from " +
+                             std::to_string(pieces) + " pieces");
+    return;
+  }
+  if (!subtrees.empty()) throw std::logic_error("bvh8: subtrees in a tree over triangles");
   std::uint32_t missing = 0;
   for (std::uint32_t p = 0; p < scene_triangles; ++p) missing += c.seen_prim[p] ? 0 : 1;
   if (missing != left_out)

@@ -14,7 +14,10 @@
 /// Child reference (32 bits): the low 4 bits are 0 for an inner node, whose
 /// index is ref >> 4, or the number n of triangles (1..4) of a leaf, whose
 /// first entry in the leaf lists is ref >> 4. Node 0 is the root and never a
-/// child, so reference 0 in a slot means "empty".
+/// child, so reference 0 in a slot means "empty". Low bits 15 (kSubtree) mark
+/// a BSP subtree under the box (issue #26 step two, bsp_traverse.h's
+/// set_bvh8_top): ref >> 4 indexes Bvh8Tree::subtrees, and the kernel hands
+/// the ray to the tracer's subtree callback (bvh8_kernel.h).
 ///
 /// A leaf's triangles are stored twice. For the float kernel, which tests
 /// them at once in four lanes (as Embree tests its Triangle4 leaves), in SoA
@@ -40,11 +43,13 @@ struct alignas(32) Bvh8Node {
 
   static constexpr std::uint32_t kLeafMask = 0xfu;
   static constexpr std::uint32_t kMaxLeafSize = 4;
+  static constexpr std::uint32_t kSubtree = 0xfu;  ///< count() of a BSP subtree reference
   static bool is_leaf(std::uint32_t ref) { return (ref & kLeafMask) != 0; }
   static std::uint32_t index(std::uint32_t ref) { return ref >> 4; }
   static std::uint32_t count(std::uint32_t ref) { return ref & kLeafMask; }
   static std::uint32_t inner_ref(std::uint32_t node) { return node << 4; }
   static std::uint32_t leaf_ref(std::uint32_t first, std::uint32_t n) { return (first << 4) | n; }
+  static std::uint32_t subtree_ref(std::uint32_t subtree) { return (subtree << 4) | kSubtree; }
   /// A node whose eight slots are empty.
   static Bvh8Node empty();
   /// Sets slot i to `ref` with box b.
@@ -55,8 +60,22 @@ struct alignas(32) Bvh8Node {
 static_assert(sizeof(Bvh8Node) == 224, "Bvh8Node: 6 x 8 floats + 8 references");
 static_assert(alignof(Bvh8Node) == 32, "Bvh8Node rows are loaded as aligned 32-byte vectors");
 
+/// A BSP subtree under a leaf slot of a BVH8 top: its root slot in the
+/// compact BSP tree and its certified box (bsp_boxtop.h, BspSubtreeBox).
+struct Bvh8Subtree {
+  std::uint32_t slot;
+  Box3f box;
+};
+
 /// The tree: nodes (0 = root, always an inner node), and the leaf lists in
 /// leaf order: corners in SoA rows, triangle numbers, corners as triangles.
+///
+/// A top over a BSP tree (`over_bsp`) has pieces of the BSP's leaf cells as
+/// leaves: a leaf cell of at most four triangles becomes a triangle leaf,
+/// anything else a subtree reference. Such a leaf's box is the certified box
+/// of its cell's piece (bsp_boxtop.h), so a triangle may reach outside it and
+/// be listed in several leaves; the BSP's certificate, not the leaf boxes,
+/// says that no hit is lost (docs/bvh8.md, "BSP subtrees below").
 struct Bvh8Tree {
   std::vector<Bvh8Node> nodes;
   std::vector<float> leaf_soa;  ///< 9 floats per leaf entry (see the file comment), then 3 spare
@@ -65,16 +84,22 @@ struct Bvh8Tree {
   std::uint32_t depth = 0;              ///< levels of inner nodes (root = 1)
   std::uint32_t scene_triangles = 0;    ///< triangles of the scene it was built for
   std::uint32_t left_out = 0;           ///< degenerate (or non-finite) triangles, in no leaf: no mode hits them
+  std::vector<Bvh8Subtree> subtrees;    ///< BSP subtrees (kSubtree references), over_bsp only
+  bool over_bsp = false;                ///< leaves are pieces of BSP cells (see above)
+  std::uint32_t pieces = 0;             ///< over_bsp: leaf cells and subtrees it was built from
 
   /// Checks the invariants; throws std::logic_error naming the broken one:
   /// references in range, every node reached once, each child's box holds
   /// its subtree's boxes and a leaf's box its triangles' corners, SoA rows
   /// equal to the lists, every triangle in at most one leaf and exactly
-  /// `left_out` in none.
+  /// `left_out` in none. Over a BSP: the same, except that leaf boxes need
+  /// not hold their triangles and triangles may repeat; instead every subtree
+  /// is referenced once, and leaves plus subtrees number `pieces`.
   void validate() const;
   std::size_t memory_bytes() const {
     return nodes.size() * sizeof(Bvh8Node) + leaf_soa.size() * sizeof(float) +
-           prims.size() * sizeof(std::uint32_t) + triangles.size() * sizeof(LeafTriangle);
+           prims.size() * sizeof(std::uint32_t) + triangles.size() * sizeof(LeafTriangle) +
+           subtrees.size() * sizeof(Bvh8Subtree);
   }
 };
 

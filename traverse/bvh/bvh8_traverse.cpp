@@ -67,12 +67,7 @@ Hit Bvh8Tracer::trace_every_triangle(const Ray& ray, RayCounters* counters) cons
   return hit;
 }
 
-Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
-  if (huge_scene_ || !(max_abs(ray.org) <= kHuge)) {
-    if (counters) ++counters->rays;
-    return is_valid(ray) ? trace_every_triangle(ray, counters) : Hit{};
-  }
-  const detail::Bvh8View v = view();
+Hit Bvh8Tracer::run(const detail::Bvh8View& v, const Ray& ray, RayCounters* counters) const {
   switch (isa_) {
     case Isa::Avx512:
       return detail::bvh8_trace_avx512(v, ray, counters);
@@ -83,9 +78,7 @@ Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
   }
 }
 
-bool Bvh8Tracer::occluded(const Ray& ray, RayCounters* counters) const {
-  if (huge_scene_ || !(max_abs(ray.org) <= kHuge)) return trace(ray, counters).hit();
-  const detail::Bvh8View v = view();
+bool Bvh8Tracer::run_occluded(const detail::Bvh8View& v, const Ray& ray, RayCounters* counters) const {
   switch (isa_) {
     case Isa::Avx512:
       return detail::bvh8_occluded_avx512(v, ray, counters);
@@ -96,8 +89,38 @@ bool Bvh8Tracer::occluded(const Ray& ray, RayCounters* counters) const {
   }
 }
 
+Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
+  if (tree_.over_bsp) throw UsageError("bvh8: a tree over a BSP is traced through its BspTracer");
+  if (huge_scene_ || !(max_abs(ray.org) <= kHuge)) {
+    if (counters) ++counters->rays;
+    return is_valid(ray) ? trace_every_triangle(ray, counters) : Hit{};
+  }
+  return run(view(), ray, counters);
+}
+
+bool Bvh8Tracer::occluded(const Ray& ray, RayCounters* counters) const {
+  if (tree_.over_bsp) throw UsageError("bvh8: a tree over a BSP is traced through its BspTracer");
+  if (huge_scene_ || !(max_abs(ray.org) <= kHuge)) return trace(ray, counters).hit();
+  return run_occluded(view(), ray, counters);
+}
+
+Hit Bvh8Tracer::trace_with(const Ray& ray, detail::Bvh8SubtreeFn fn, void* ctx, RayCounters* counters) const {
+  detail::Bvh8View v = view();
+  v.subtree = fn;
+  v.subtree_ctx = ctx;
+  return run(v, ray, counters);
+}
+
+bool Bvh8Tracer::occluded_with(const Ray& ray, detail::Bvh8SubtreeFn fn, void* ctx, RayCounters* counters) const {
+  detail::Bvh8View v = view();
+  v.subtree = fn;
+  v.subtree_ctx = ctx;
+  return run_occluded(v, ray, counters);
+}
+
 detail::Bvh8View Bvh8Tracer::view() const {
-  return {tree_.nodes.data(), tree_.leaf_soa.data(), tree_.prims.data(), tree_.triangles.data(), exact_leaf_};
+  return {tree_.nodes.data(), tree_.leaf_soa.data(), tree_.prims.data(), tree_.triangles.data(), exact_leaf_, nullptr,
+          nullptr};
 }
 
 }  // namespace bsprt

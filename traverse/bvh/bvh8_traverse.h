@@ -17,6 +17,7 @@
 namespace bsprt {
 namespace detail {
 struct Bvh8View;
+using Bvh8SubtreeFn = void (*)(void* ctx, std::uint32_t subtree, Hit& hit, NearestHit& nearest, RayCounters* c);
 }
 
 /// The BVH8 behind the Accelerator interface.
@@ -41,6 +42,12 @@ class Bvh8Tracer final : public Accelerator {
   /// trace(ray).hit() at a fraction of the work on rays that hit.
   bool occluded(const Ray& ray, RayCounters* counters = nullptr) const override;
   std::size_t memory_bytes() const override { return tree_.memory_bytes(); }
+  /// A tree over a BSP (Bvh8Tree::over_bsp; trace() refuses it): the same
+  /// kernel, with `fn(ctx, ...)` tracing the ray through the BSP subtrees
+  /// (BspTracer::set_bvh8_top). No fallback for huge coordinates: the caller
+  /// keeps the ray and the scene within the BSP's safe range.
+  Hit trace_with(const Ray& ray, detail::Bvh8SubtreeFn fn, void* ctx, RayCounters* counters) const;
+  bool occluded_with(const Ray& ray, detail::Bvh8SubtreeFn fn, void* ctx, RayCounters* counters) const;
 
   const Bvh8Tree& tree() const { return tree_; }
   /// The kernel's ISA: Avx512 or Avx2 (the widest the CPU has) or Scalar (plain x86-64).
@@ -55,6 +62,9 @@ class Bvh8Tracer final : public Accelerator {
  private:
   Hit trace_every_triangle(const Ray& ray, RayCounters* counters) const;
   detail::Bvh8View view() const;
+  /// The kernel of isa_ (the ISA switch, once).
+  Hit run(const detail::Bvh8View& v, const Ray& ray, RayCounters* counters) const;
+  bool run_occluded(const detail::Bvh8View& v, const Ray& ray, RayCounters* counters) const;
 
   Bvh8Tree tree_;
   const LeafIntersector* exact_leaf_ = nullptr;

@@ -5,7 +5,10 @@
 /// them, and the boxes are then recomputed from the triangles' float corners
 /// (exact min/max), so the tree's certificate does not rest on Embree.
 
+#include <cstdint>
+
 #include "geometry/core/triangle_soup.h"
+#include "traverse/bsp/bsp_traverse.h"
 #include "traverse/bvh/bvh8_node.h"
 
 namespace bsprt {
@@ -22,5 +25,18 @@ struct Bvh8Config {
 /// mode hits them). Throws UsageError for a bad config, std::runtime_error
 /// when Embree fails.
 Bvh8Tree build_bvh8(const TriangleSoup& soup, const Bvh8Config& config = {});
+
+/// A BVH8 top over `bsp` (issue #26 step two; Bvh8Tree::over_bsp): the tree
+/// cut into pieces (BspTracer::subtree_boxes), each a leaf of the BVH8 under
+/// its certified box. A subtree whose leaves list at most `leaf_triangles`
+/// distinct triangles becomes a triangle leaf of those (tested at once, four
+/// lanes); the rest are cut into subtrees of at most `max_slots` slots and
+/// stay BSP subtrees. leaf_triangles 0: only the size rule (every piece a
+/// subtree). Throws UsageError for max_slots 0 or leaf_triangles > 4,
+/// std::runtime_error when Embree fails.
+Bvh8Tree build_bvh8_over_bsp(const BspTracer& bsp, std::uint32_t max_slots, std::uint32_t leaf_triangles = 4);
+
+/// tracer.set_bvh8_top(build_bvh8_over_bsp(tracer, max_slots)).
+void add_bvh8_top(BspTracer& tracer, std::uint32_t max_slots);
 
 }  // namespace bsprt
