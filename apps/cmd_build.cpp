@@ -89,10 +89,18 @@ void print_bsp_figures(const BspFigures& f) {
   for (std::size_t d = 0; d < depth; ++d)
     fmt::print("{}{}: {}/{}", d % 8 ? "  " : "\n  ", d, d < f.kd_by_depth.size() ? f.kd_by_depth[d] : 0,
                d < f.bsp_by_depth.size() ? f.bsp_by_depth[d] : 0);
+  // Every leaf is counted: one bin per count below 16, then bins of doubling
+  // width ([16-31], [32-63], ...), and the largest leaf.
   fmt::print("\nleaves by triangle count:");
-  for (std::size_t n = 0; n < f.leaf_histogram.size(); ++n)
-    if (f.leaf_histogram[n] && (n < 16 || n + 1 == f.leaf_histogram.size()))
-      fmt::print(" [{}]={}", n, f.leaf_histogram[n]);
+  const std::size_t bins = f.leaf_histogram.size();
+  for (std::size_t n = 0; n < std::min<std::size_t>(bins, 16); ++n)
+    if (f.leaf_histogram[n]) fmt::print(" [{}]={}", n, f.leaf_histogram[n]);
+  for (std::size_t lo = 16; lo < bins; lo *= 2) {
+    std::size_t count = 0;
+    for (std::size_t n = lo; n < std::min(bins, 2 * lo); ++n) count += f.leaf_histogram[n];
+    if (count) fmt::print(" [{}-{}]={}", lo, 2 * lo - 1, count);
+  }
+  if (bins > 0) fmt::print("; largest {}", bins - 1);
   fmt::print("\n");
 }
 

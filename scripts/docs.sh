@@ -55,9 +55,11 @@ VERTEX_CMD=(bench "$SCENES/stanford-bunny.obj" --rays vertex --modes "$MODES"
 INSIDE_CMD=(bench icosphere:4 icosphere:6 --rays inside,vertex --modes "$MODES" --count "$COUNT"
             --error-count "$ERROR_COUNT" -o "$PERF" --prefix inside)
 "$BSPRT" "${INSIDE_CMD[@]}" | tee "$PERF/inside.txt"
-# 4. Scaling: generated icospheres (the meshes' random-ray rows come from step 1).
+# 4. Scaling: generated icospheres and the full dragon (the other meshes' random-ray rows come
+#    from steps 1 and 5).
 scaling_scenes=()
 for l in $SCALING_LEVELS; do scaling_scenes+=("icosphere:$l"); done
+scaling_scenes+=("$SCENES/stanford-dragon-871k.ply")
 SCALING_CMD=(bench "${scaling_scenes[@]}" --rays random --modes kd,bsp,embree --count 65536 --error-count 0
              -o "$PERF" --prefix scaling)
 "$BSPRT" "${SCALING_CMD[@]}" | tee "$PERF/scaling.txt"

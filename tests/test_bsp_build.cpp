@@ -443,6 +443,33 @@ std::size_t largest_leaf(const BspTree& t) {
 }
 }  // namespace
 
+TEST_CASE("bsp: a bundle of slanted slivers that no kd plane refines is split by face/edge planes "
+          "(regression: conference's leaves of 49 to 117 triangles)",
+          "[bsp]") {
+  // A paddle wheel of 100 long, thin blades along the diagonal (1,1,1): every axis plane
+  // between the ends cuts every blade, so kd splits cannot refine it, and with more than
+  // bsp_max_triangles (48) triangles no face/edge plane used to be offered: one leaf of 100.
+  TriangleSoup s;
+  const Vec3f axis = Vec3f(1, 1, 1) * (1.0f / std::sqrt(3.0f));
+  const Vec3f u = Vec3f(1, -1, 0) * (1.0f / std::sqrt(2.0f));
+  const Vec3f v = cross(axis, u);
+  const int blades = 100;
+  for (int k = 0; k < blades; ++k) {
+    const float a = 6.2831853f * float(k) / float(blades);
+    const Vec3f w = u * std::cos(a) + v * std::sin(a);
+    add_tri(s, w * 0.01f, Vec3f(10, 10, 10) + w * 0.01f, Vec3f(5, 5, 5) + w * 0.4f);
+  }
+  BspConfig c;
+  c.threads = 1;
+  const BspTree now = build_bsp(s, c);
+  REQUIRE_NOTHROW(now.validate(s.size(), &s));
+  c.bsp_max_triangles = 0;  // kd planes only: what a node above 48 triangles was offered before
+  const BspTree kd_only = build_bsp(s, c);
+  INFO("largest leaf: " << largest_leaf(now) << " triangles, kd planes only " << largest_leaf(kd_only));
+  CHECK(largest_leaf(kd_only) == blades);
+  CHECK(largest_leaf(now) <= 16);
+}
+
 TEST_CASE("bsp: a small dense cluster in a large scene is split (regression: conference's 1,696-triangle leaves)",
           "[bsp]") {
   // A floor and a wall 1000 across, and a sphere of 0.01 radius (960 triangles) on the floor: the

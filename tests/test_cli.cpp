@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <iterator>
 #include <string>
 #include <vector>
@@ -101,6 +102,32 @@ TEST_CASE("info reports counts of a shared mesh", "[cli]") {
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK(r.output.find("triangles   968") != std::string::npos);
+}
+
+TEST_CASE("build: the leaf histogram counts every leaf (regression: bins of 16 and more were dropped)", "[cli]") {
+  // A kd cost this high leaves large leaves (tens to hundreds of triangles). Before
+  // 2026-12-03 only counts below 16 and the largest were printed, which hid conference's
+  // 156 leaves of more than 48 triangles.
+  const Run b = bsprt_cli("build " + scene_path("suzanne.obj") + " -o " + temp_path("cli_hist.bsp") +
+                          " --accel bsp --cost-kd 3000 --cost-bsp-fixed 3000 --threads 1");
+  INFO(b.output);
+  REQUIRE(b.status == 0);
+  std::smatch m;
+  REQUIRE(std::regex_search(b.output, m, std::regex("leaves ([0-9]+) \\(")));
+  const long leaves = std::stol(m[1]);
+  const std::size_t at = b.output.find("leaves by triangle count:");
+  REQUIRE(at != std::string::npos);
+  const std::string line = b.output.substr(at, b.output.find('\n', at) - at);
+  long sum = 0, grouped = 0;
+  const std::regex bin("\\[([0-9]+)(-[0-9]+)?\\]=([0-9]+)");
+  for (auto it = std::sregex_iterator(line.begin(), line.end(), bin); it != std::sregex_iterator(); ++it) {
+    sum += std::stol((*it)[3]);
+    if ((*it)[2].matched) grouped += std::stol((*it)[3]);
+  }
+  CHECK(sum == leaves);
+  CHECK(grouped > 0);  // this build has leaves of 16 triangles or more
+  REQUIRE(std::regex_search(line, m, std::regex("largest ([0-9]+)")));
+  CHECK(std::stol(m[1]) >= 16);
 }
 
 TEST_CASE("build, stats and trace a BSP tree file end to end", "[cli]") {

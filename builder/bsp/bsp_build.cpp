@@ -149,35 +149,53 @@ std::unique_ptr<BuildNode> Builder::build(Cell cell, std::vector<ClippedTriangle
   const std::size_t n = tris.size();
   std::vector<Candidate> cands;
   double area = 0;
+  std::size_t nkd = 0;
+  const bool bsp_planes = cfg_.face_candidates || cfg_.edge_candidates;
+  const auto add_bsp = [&] {
+    RoundingGuard g;
+    add_bsp_candidates(g, soup_, make_node_view(soup_, cell, tris), cfg_, nkd > 0, cands, st);
+  };
   {
     RoundingGuard g;
     const NodeView v = make_node_view(soup_, cell, tris);
     area = v.area;
     if (n == 0 || depth >= cfg_.max_depth) return make_leaf(tris, weight, area, n > 0, st);
-    const std::size_t nkd = add_kd_candidates(v, cfg_, cands);
-    if (n <= cfg_.bsp_max_triangles && (cfg_.face_candidates || cfg_.edge_candidates))
-      add_bsp_candidates(g, soup_, v, cfg_, nkd > 0, cands, st);
+    nkd = add_kd_candidates(v, cfg_, cands);
+    if (n <= cfg_.bsp_max_triangles && bsp_planes) add_bsp_candidates(g, soup_, v, cfg_, nkd > 0, cands, st);
   }
-  std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) {
-    return a.cost < b.cost || (a.cost == b.cost && a.plane < b.plane);
-  });
   SplitResult sr;
   const Candidate* chosen = nullptr;
   // The cheapest candidates that pass worth_it are tried exactly; one that keeps
   // every triangle in a child and gains too little (often the empty-space cuts
   // around a small dense cluster) is passed over without using up an attempt.
-  int attempts = 0;
-  for (std::size_t k = 0; attempts < cfg_.max_split_attempts && k < cands.size(); ++k) {
-    if (!(cands[k].cost < cfg_.c_isect * double(n))) break;  // sorted: no later one beats the leaf
-    if (!worth_it(cands[k].cost, n, area, cands[k].keeps_all)) continue;
-    ++attempts;
-    sr = SplitResult{};
-    if (try_split(cell, tris, cands[k], area, sr, st)) {
-      chosen = &cands[k];
-      break;
+  const auto choose = [&] {
+    std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) {
+      return a.cost < b.cost || (a.cost == b.cost && a.plane < b.plane);
+    });
+    int attempts = 0;
+    for (std::size_t k = 0; attempts < cfg_.max_split_attempts && k < cands.size(); ++k) {
+      if (!(cands[k].cost < cfg_.c_isect * double(n))) break;  // sorted: no later one beats the leaf
+      if (!worth_it(cands[k].cost, n, area, cands[k].keeps_all)) continue;
+      ++attempts;
+      sr = SplitResult{};
+      if (try_split(cell, tris, cands[k], area, sr, st)) {
+        chosen = &cands[k];
+        return;
+      }
+      std::lock_guard<std::mutex> lock(mu_);
+      ++failed_;
     }
-    std::lock_guard<std::mutex> lock(mu_);
-    ++failed_;
+  };
+  choose();
+  // Above bsp_max_triangles only kd planes are offered, since they almost always
+  // win there. When none pays, the node would become a large leaf: a bundle of
+  // long, thin, slanted triangles that every axis plane cuts (conference: a
+  // 117-triangle leaf of slivers). Only then are face and edge planes evaluated
+  // for it, as the paper's combined SAH would.
+  if (!chosen && cfg_.bsp_max_triangles > 0 && n > cfg_.bsp_max_triangles && bsp_planes) {
+    cands.clear();
+    add_bsp();
+    choose();
   }
   if (!chosen) return make_leaf(tris, weight, area, false, st);
   auto node = std::make_unique<BuildNode>();

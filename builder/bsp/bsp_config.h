@@ -53,7 +53,9 @@ struct BspConfig {
   /// Evaluate face/edge (BSP) candidates only when the node holds at most this
   /// many triangles. Above it C_BSP ≥ 7.5·N so kd splits almost always win and
   /// the O(N²)-ish BSP evaluation is wasted (docs/bsp-build.md "Costs";
-  /// leave out what a scene does not need). 0 = kd-tree only; SIZE_MAX = the paper's full BSP.
+  /// leave out what a scene does not need). A larger node that no kd split can
+  /// refine gets them too, before it is made a leaf (bsp_build.cpp). 0 = kd-tree
+  /// only; SIZE_MAX = the paper's full BSP.
   std::size_t bsp_max_triangles = 48;
   /// Count BSP candidates with the bounding-sphere hierarchy (bsh.h) when the
   /// node holds at least this many triangles; below it, a flat sphere list.
