@@ -8,9 +8,11 @@
 // box test are what keeps them.
 #include <catch2/catch.hpp>
 
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <random>
 
 #include "builder/accel_factory.h"
 #include "bsprt/compare.h"
@@ -27,6 +29,7 @@
 #include "traverse/brute_force.h"
 #include "traverse/bvh/bvh8_traverse.h"
 #include "traverse/embree/bvh8_build.h"
+#include "traverse/exact_prefilter.h"
 
 using namespace bsprt;
 
@@ -288,6 +291,41 @@ void check_exact_hit(const TriangleSoup& s, const Ray& ray) {
 // Found reviewing the exact leaves' float filter (issue #26): with a direction
 // component of 2^-149 the shear sx rounds to a subnormal with far more than
 // 2^-24 relative error, and the filter's bound called a hit a certain miss.
+// The prefilter's bound is computed without subnormal operands (exact_prefilter.h); it must
+// equal the documented formula max(2^-18 Mx My, 2^-145 (Mx + My), 2^-120), evaluated in
+// plain float operations, bit for bit (NaN as NaN) on random magnitudes and the edges.
+TEST_CASE("exact prefilter: the bound equals its formula", "[bvh8][prefilter]") {
+  const auto formula = [](float mx, float my) {
+    const auto mx_ = [](float a, float b) { return a > b ? a : b; };  // simd::max's order
+    volatile float tiny = 0x1p-145f;  // volatile: evaluated at run time, subnormal and all
+    return mx_(mx_(0x1p-18f * (mx * my), tiny * (mx + my)), 0x1p-120f);
+  };
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> v = {0.0f, 0x1p-149f, 0x1p-126f, 1e-30f, 1e-3f, 1.0f, 0x1p24f, 0x1.fffffep24f, 0x1p25f,
+                          0x1.000002p25f, 3e7f, 1e20f, std::numeric_limits<float>::max(), inf, nan};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> e(-140.0f, 126.0f);
+  for (int i = 0; i < 2000; ++i) v.push_back(std::exp2(e(rng)));
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < v.size(); i += 4) {
+    for (std::size_t j = 0; j < v.size(); j += 97) {
+      float a[4], b[4];
+      for (int k = 0; k < 4; ++k) a[k] = v[(i + k) % v.size()], b[k] = v[(j + 13 * k) % v.size()];
+      const auto got = detail::exact_filter_bound(simd::load<4>(a), simd::load<4>(b));
+      for (int k = 0; k < 4; ++k) {
+        const float want = formula(a[k], b[k]);
+        INFO("mx " << a[k] << " my " << b[k]);
+        if (std::isnan(want))
+          CHECK(std::isnan(got[k]));
+        else
+          CHECK(std::bit_cast<std::uint32_t>(got[k]) == std::bit_cast<std::uint32_t>(want));
+        ++checked;
+      }
+    }
+  }
+  CHECK(checked > 10000);
+}
+
 // A ray with a nonzero subnormal shear now keeps every lane.
 TEST_CASE("bvh8: a subnormal shear does not let the float filter drop a hit", "[bvh8][regression]") {
   const float z = 0x1p120f;

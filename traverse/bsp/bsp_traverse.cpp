@@ -245,12 +245,15 @@ Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCoun
 /// BSP's constants are made at the first subtree the ray enters (most random
 /// rays enter none).
 struct WideRay {
+  /// rc is left unset until set_up (aggregate initialization cleared it for
+  /// every ray with a `rep stos`, whose start-up cost shows on short rays).
+  WideRay(const BspView* view, const Ray* r, const Bvh8Subtree* s) : v(view), ray(r), subtrees(s) {}
   const BspView* v;
   const Ray* ray;
   const Bvh8Subtree* subtrees;
   bool set_up = false;
   bool sheared = false;
-  BspRayConst rc;
+  BspRayConst rc;    ///< made at the first subtree the ray enters
   WatertightRay wr;  ///< made at the first float leaf test
 };
 
