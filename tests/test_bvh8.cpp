@@ -288,9 +288,6 @@ void check_exact_hit(const TriangleSoup& s, const Ray& ray) {
 
 }  // namespace
 
-// Found reviewing the exact leaves' float filter (issue #26): with a direction
-// component of 2^-149 the shear sx rounds to a subnormal with far more than
-// 2^-24 relative error, and the filter's bound called a hit a certain miss.
 // The prefilter's bound is computed without subnormal operands (exact_prefilter.h); it must
 // equal the documented formula max(2^-18 Mx My, 2^-145 (Mx + My), 2^-120), evaluated in
 // plain float operations, bit for bit (NaN as NaN) on random magnitudes and the edges.
@@ -326,6 +323,9 @@ TEST_CASE("exact prefilter: the bound equals its formula", "[bvh8][prefilter]") 
   CHECK(checked > 10000);
 }
 
+// Found reviewing the exact leaves' float filter (issue #26): with a direction
+// component of 2^-149 the shear sx rounds to a subnormal with far more than
+// 2^-24 relative error, and the filter's bound called a hit a certain miss.
 // A ray with a nonzero subnormal shear now keeps every lane.
 TEST_CASE("bvh8: a subnormal shear does not let the float filter drop a hit", "[bvh8][regression]") {
   const float z = 0x1p120f;

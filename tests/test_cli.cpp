@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <iterator>
+#include <regex>
 #include <string>
 #include <vector>
 
