@@ -9,6 +9,8 @@
 #include <limits>
 #include <optional>
 
+#include "traverse/exact_double_stage.h"
+
 namespace bsprt {
 namespace {
 
@@ -19,18 +21,8 @@ using Mp = CGAL::Mpzf;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-/// Test hook (CertifiedIntersector::set_filter_off_for_testing): the weights
-/// whose bit is set go to the rules and the exact stage even when the filter
-/// decided them.
-unsigned filter_off_for_testing = 0;
-
-/// Relative bound of the double filter (docs/exact-leaf-test.md, "The double
-/// filter"): every quantity below is a sum of at most six monomials of degree
-/// three in float inputs, computed with at most 8 roundings of 2^-53 each on
-/// any path, so its error is below 8 * 2^-53 * (sum of |monomials|) * (1 + 2^-49).
-/// 2^-48 (32 roundings) leaves a wide margin for that and for the max-abs
-/// bound of the monomials, which is itself rounded.
-constexpr double kRel = 0x1p-48;
+using detail::ExactRayConst;
+using detail::Stage;
 
 struct D3 {
   double x, y, z;
@@ -38,10 +30,6 @@ struct D3 {
 D3 dsub(const Vec3f& a, const Vec3f& b) {
   return {double(a.x) - double(b.x), double(a.y) - double(b.y), double(a.z) - double(b.z)};
 }
-D3 dvec(const Vec3f& a) { return {double(a.x), double(a.y), double(a.z)}; }
-double dot(const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-D3 cross(const D3& a, const D3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-double maxabs(const D3& a) { return std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)}); }
 
 /// Whether a - b (floats) is exact in double: Knuth's two-sum error is zero.
 bool exact_difference(float a, float b) {
@@ -112,16 +100,11 @@ float round_exact(const ExactT& e, double& lo, double& hi) {
   }
 }
 
-/// -1, 0, +1 from the double filter, or 2 when |x| <= bound.
-int filtered_sign(double x, double bound) { return x > bound ? 1 : (x < -bound ? -1 : 2); }
-
 /// One sign for all three weights, not all zero: the line meets the triangle.
 bool meets(int su, int sv, int sw) {
   const bool neg = su < 0 || sv < 0 || sw < 0, pos = su > 0 || sv > 0 || sw > 0;
   return !(neg && pos) && (neg || pos);
 }
-/// Two decided signs that differ: the line misses, whatever the third is.
-bool opposite(int a, int b) { return (a == 1 && b == -1) || (a == -1 && b == 1); }
 
 /// A hit of one triangle: the float t, an enclosure [t_lo, t_hi] of the
 /// exact t, the barycentrics and where on the triangle it lies.
@@ -137,35 +120,6 @@ struct Candidate {
 struct Stages {
   std::uint64_t rule = 0, exact = 0;
 };
-
-/// Per-ray constants of the double filter: the watertight test's shear
-/// (Woop, Benthin and Wald, JCGT 2013) in double. kz is the axis of the
-/// largest |d|, and (kx, ky, kz) is cyclic, or swapped when d[kz] < 0, so the
-/// sheared 2D cross products have the signs of the Plücker volumes
-/// (docs/exact-leaf-test.md, "The double filter").
-struct FilterRay {
-  D3 d;
-  double abs_d;  ///< |d[kz]|: sheared volumes are the Plücker ones divided by it
-  int kx, ky, kz;
-  double sx, sy, asx, asy;  ///< d[kx] / d[kz], d[ky] / d[kz] and their magnitudes
-};
-double at(const D3& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
-FilterRay filter_ray(const Ray& ray) {
-  FilterRay f;
-  f.d = dvec(ray.dir);
-  const double ax = std::abs(f.d.x), ay = std::abs(f.d.y), az = std::abs(f.d.z);
-  f.kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
-  f.kx = f.kz == 2 ? 0 : f.kz + 1;
-  f.ky = f.kx == 2 ? 0 : f.kx + 1;
-  if (at(f.d, f.kz) < 0) std::swap(f.kx, f.ky);
-  const double dz = at(f.d, f.kz);
-  f.abs_d = std::abs(dz);
-  f.sx = at(f.d, f.kx) / dz;
-  f.sy = at(f.d, f.ky) / dz;
-  f.asx = std::abs(f.sx);
-  f.asy = std::abs(f.sy);
-  return f;
-}
 
 /// Simulation of simplicity for a weight that is exactly 0: its sign when the
 /// origin moves to o + (e, e^2, e^3) for an infinitesimal e > 0. The weight
@@ -183,43 +137,28 @@ int sos_sign(const Vec3f& p, const Vec3f& q, const Vec3f& dir) {
 /// `sos`, a crossing of the perturbed ray instead (sos_sign): exact zeros
 /// take their perturbed signs, so a ray through a shared edge or vertex of a
 /// closed, consistently oriented mesh crosses exactly one triangle of each sheet.
-std::optional<Candidate> test_one(const Ray& ray, const FilterRay& fr, const std::array<Vec3f, 3>& tri, Stages& st,
+std::optional<Candidate> test_one(const Ray& ray, const ExactRayConst& fr, const std::array<Vec3f, 3>& tri, Stages& st,
                                   bool sos = false) {
-  // Double stage: the sheared vertices, then the weights of v0, v1, v2 as 2D
-  // cross products, each with the static bound 2^-47 * Mx * My, where Mx and
-  // My bound |a[kx]| + |sx| |a[kz]| and |a[ky]| + |sy| |a[kz]| over the corners.
-  const D3 a0 = dsub(tri[0], ray.org), a1 = dsub(tri[1], ray.org), a2 = dsub(tri[2], ray.org);
-  const double c0[3] = {a0.x, a0.y, a0.z}, c1[3] = {a1.x, a1.y, a1.z}, c2[3] = {a2.x, a2.y, a2.z};
-  const double z0 = c0[fr.kz], z1 = c1[fr.kz], z2 = c2[fr.kz];
-  const double x0 = c0[fr.kx] - fr.sx * z0, y0 = c0[fr.ky] - fr.sy * z0;
-  const double x1 = c1[fr.kx] - fr.sx * z1, y1 = c1[fr.ky] - fr.sy * z1;
-  const double x2 = c2[fr.kx] - fr.sx * z2, y2 = c2[fr.ky] - fr.sy * z2;
-  const double az = std::max(std::max(std::abs(z0), std::abs(z1)), std::abs(z2));
-  const double ax = std::max(std::max(std::abs(c0[fr.kx]), std::abs(c1[fr.kx])), std::abs(c2[fr.kx]));
-  const double ay = std::max(std::max(std::abs(c0[fr.ky]), std::abs(c1[fr.ky])), std::abs(c2[fr.ky]));
-  const double mx = ax + fr.asx * az, my = ay + fr.asy * az;  // bounds of |a[kx]| + |sx| |a[kz]|, ...
-  const double bound = 0x1p-47 * (mx * my);
-  double w[3];
-  int s[3];
-  w[0] = x1 * y2 - y1 * x2;
-  w[1] = x2 * y0 - y2 * x0;
-  s[0] = filtered_sign(w[0], bound);
-  s[1] = filtered_sign(w[1], bound);
-  if (opposite(s[0], s[1])) return std::nullopt;  // a miss whatever the third weight is
-  w[2] = x0 * y1 - y0 * x1;
-  s[2] = filtered_sign(w[2], bound);
-  if (opposite(s[0], s[2]) || opposite(s[1], s[2])) return std::nullopt;
-  if (filter_off_for_testing != 0) {
+  // Double stage (exact_double_stage.h): the weights of v0, v1, v2 as
+  // sheared 2D cross products, each with its static bound.
+  const std::array<float, 9> floats{tri[0].x, tri[0].y, tri[0].z, tri[1].x, tri[1].y,
+                                    tri[1].z, tri[2].x, tri[2].y, tri[2].z};
+  detail::StageWeights sw;
+  if (detail::double_weights(fr, floats, sw) == Stage::Miss) return std::nullopt;  // whatever the third weight is
+  double* const w = sw.w;
+  int* const s = sw.s;
+  if (exact_filter_off_for_testing != 0) {
     for (int k = 0; k < 3; ++k)
-      if ((filter_off_for_testing >> k) & 1u) s[k] = 2;
+      if ((exact_filter_off_for_testing >> k) & 1u) s[k] = 2;
   }
   if (s[0] == 2 || s[1] == 2 || s[2] == 2) {
     // A vertex exactly on the ray's line through o + d: the two weights that
     // pair it with d are triple products with a repeated vector, exactly 0.
-    const D3* a[3] = {&a0, &a1, &a2};
+    const D3 a[3] = {dsub(tri[0], ray.org), dsub(tri[1], ray.org), dsub(tri[2], ray.org)};
+    const D3 d{fr.d[0], fr.d[1], fr.d[2]};
     bool rule = false;
     for (int i = 0; i < 3; ++i) {
-      if (!exactly_on_direction(tri[i], ray.org, *a[i], fr.d)) continue;
+      if (!exactly_on_direction(tri[i], ray.org, a[i], d)) continue;
       for (int k = 0; k < 3; ++k)
         if (k != i && s[k] == 2) s[k] = 0, w[k] = 0.0, rule = true;
     }
@@ -257,37 +196,15 @@ std::optional<Candidate> test_one(const Ray& ray, const FilterRay& fr, const std
     c.p = tri[(k + 1) % 3];
     c.q = tri[(k + 2) % 3];
   }
-  const double sum = w[0] + w[1] + w[2];
-  c.u = float(w[1] / sum);
-  c.v = float(w[2] / sum);
+  detail::stage_barycentrics(sw.w, c.u, c.v);
 
-  // t = n.(v0 - o) / n.d in double with its static bound.
-  const D3 f1 = dsub(tri[1], tri[0]), f2 = dsub(tri[2], tri[0]);
-  const D3 n = cross(f1, f2);
-  const double mn = 2 * maxabs(f1) * maxabs(f2);
-  double num = dot(n, a0), den = dot(n, fr.d);
-  const double enum_ = 3 * kRel * (mn * maxabs(a0)), eden = 3 * kRel * (mn * maxabs(fr.d));
-  const double tnear = ray.tnear, tfar = ray.tfar;
-  bool decided = false;
-  if (std::abs(den) > eden) {
-    if (den < 0) num = -num, den = -den;
-    const double nl = num - enum_, nh = num + enum_, dl = den - eden, dh = den + eden;
-    double lo = nl >= 0 ? nl / dh : nl / dl, hi = nh >= 0 ? nh / dl : nh / dh;
-    lo -= std::abs(lo) * 0x1p-51;  // the division's rounding
-    hi += std::abs(hi) * 0x1p-51;
-    if (hi < tnear || lo > tfar) return std::nullopt;
-    if (lo >= tnear && hi <= tfar) {
-      const float fl = float(lo), fh = float(hi);
-      if (fl == fh) {
-        if (std::isinf(fl)) return std::nullopt;  // beyond the float range: a miss (docs/exact-leaf-test.md)
-        c.t = fl, c.t_lo = lo, c.t_hi = hi;
-        decided = true;
-      }
-    }
-  }
-  if (!decided) {
+  // t in double with its static bound (exact_double_stage.h), else exactly.
+  const Stage ts = detail::double_t(fr, ray, floats, c.t, c.t_lo, c.t_hi);
+  if (ts == Stage::Miss) return std::nullopt;
+  if (ts == Stage::Open) {
     ++st.exact;
     const ExactT e = exact_t(ray, tri);
+    const double tnear = ray.tnear, tfar = ray.tfar;
     if (std::isfinite(tnear) && compare_t(e, tnear) < 0) return std::nullopt;
     if (std::isfinite(tfar) && compare_t(e, tfar) > 0) return std::nullopt;
     c.t = round_exact(e, c.t_lo, c.t_hi);
@@ -319,14 +236,16 @@ bool same_t_by_rule(const Candidate& c, const std::array<Vec3f, 3>& tri, const N
 
 }  // namespace
 
-CertifiedIntersector::CertifiedIntersector(const TriangleSoup& soup) : soup_(soup) {}
+CertifiedIntersector::CertifiedIntersector(const TriangleSoup& soup) : soup_(soup) {
+  staged_ = true;  // test_one runs exact_double_stage.h's functions first
+}
 
-void CertifiedIntersector::set_filter_off_for_testing(unsigned weights) { filter_off_for_testing = weights & 7u; }
+void CertifiedIntersector::set_filter_off_for_testing(unsigned weights) { exact_filter_off_for_testing = weights & 7u; }
 
 void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32_t> prims,
                                      const LeafTriangle* corners, NearestHit& best, RayCounters* counters) const {
   if (!is_valid(ray)) return;
-  const FilterRay fr = filter_ray(ray);
+  const ExactRayConst fr = detail::exact_ray_const(ray);
   Stages st;
   for (std::size_t i = 0; i < prims.size(); ++i) {
     const std::uint32_t prim = prims[i];
@@ -379,7 +298,7 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
 void CertifiedIntersector::crossings(const Ray& ray, std::span<const std::uint32_t> prims, std::vector<Crossing>& out,
                                      RayCounters* counters) const {
   if (!is_valid(ray)) return;
-  const FilterRay fr = filter_ray(ray);
+  const ExactRayConst fr = detail::exact_ray_const(ray);
   Stages st;
   for (const std::uint32_t prim : prims) {
     if (counters) ++counters->triangle_tests;

@@ -9,7 +9,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -20,6 +22,7 @@
 #include "robust/certified_intersector.h"
 #include "robust/degenerate.h"
 #include "robust/nearest_float.h"
+#include "traverse/exact_double_stage.h"
 #include "test_util.h"
 
 namespace bsprt {
@@ -269,6 +272,126 @@ TEST_CASE("exact leaf test: ties in t at midpoints of floats round to even, as t
     require_same(staged_nearest(c, r, all), reference_nearest(s, r, all));
   }
   CHECK(staged_nearest(c, make_ray({0, 0, -0x1p-24f}, {0, 0, 1}), all).t == 1.0f);
+}
+
+
+namespace {
+
+/// Both ways of testing a ray against a sequence of leaves: the intersector
+/// alone, and detail::exact_leaf_staged (the traversals' inline double stage).
+/// Every field of the nearest hit and every counter must agree after each leaf.
+void require_staged_equals_intersector(const CertifiedIntersector& c, const TriangleSoup& s, const Ray& r,
+                                       const std::vector<std::vector<std::uint32_t>>& leaves,
+                                       RayCounters& staged_counters) {
+  NearestHit a, b;
+  RayCounters ca, cb;
+  const detail::ExactRayConst fr = detail::exact_ray_const(r);
+  for (const auto& leaf : leaves) {
+    std::vector<LeafTriangle> corners;
+    for (const std::uint32_t p : leaf) corners.push_back({s.corner(p, 0), s.corner(p, 1), s.corner(p, 2)});
+    c.intersect(r, leaf, corners.data(), a, &ca);
+    detail::exact_leaf_staged(c, r, fr, leaf.data(), corners.data(), std::uint32_t(leaf.size()), b, &cb);
+    REQUIRE(b.hit.prim == a.hit.prim);
+    REQUIRE(std::bit_cast<std::uint32_t>(b.hit.t) == std::bit_cast<std::uint32_t>(a.hit.t));
+    REQUIRE(std::bit_cast<std::uint32_t>(b.hit.u) == std::bit_cast<std::uint32_t>(a.hit.u));
+    REQUIRE(std::bit_cast<std::uint32_t>(b.hit.v) == std::bit_cast<std::uint32_t>(a.hit.v));
+    REQUIRE(b.t_lo == a.t_lo);
+    REQUIRE(b.t_hi == a.t_hi);
+    REQUIRE(b.on == a.on);
+    if (a.on != 0) {
+      REQUIRE((b.p.x == a.p.x && b.p.y == a.p.y && b.p.z == a.p.z));
+      REQUIRE((b.q.x == a.q.x && b.q.y == a.q.y && b.q.z == a.q.z));
+    }
+    REQUIRE(cb.triangle_tests == ca.triangle_tests);
+    REQUIRE(cb.rule_decisions == ca.rule_decisions);
+    REQUIRE(cb.exact_decisions == ca.exact_decisions);
+  }
+  staged_counters.triangle_tests += cb.triangle_tests;
+  staged_counters.exact_decisions += cb.exact_decisions;
+  staged_counters.rule_decisions += cb.rule_decisions;
+}
+
+}  // namespace
+
+TEST_CASE("staged exact leaf: equals the certified intersector, field for field and counter for counter",
+          "[exact][exact-leaf]") {
+  // A mix that reaches every branch: random triangles (the double stage
+  // decides), a closed fan with rays through its vertices and edges (rules
+  // and the exact stage), coplanar duplicates with reversed winding (ties),
+  // a collinear and a non-finite triangle (never hit), the same triangle in
+  // two leaves, and rays whose t lies at tnear or tfar.
+  std::mt19937 rng(2026);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  auto p = [&] { return Vec3f{u(rng), u(rng), u(rng)}; };
+  std::vector<std::array<Vec3f, 3>> tris;
+  for (int i = 0; i < 40; ++i) tris.push_back({p(), p(), p()});
+  const Vec3f v{0.3f, 0.2f, 0.7f};
+  std::vector<Vec3f> ring;
+  for (int k = 0; k < 6; ++k) {
+    const float a = float(k) * 1.0471976f;
+    ring.push_back({0.3f + 0.5f * std::cos(a), 0.2f + 0.5f * std::sin(a), 0.7f + 0.1f * std::cos(2 * a + 0.5f)});
+  }
+  for (int k = 0; k < 6; ++k) tris.push_back({v, ring[k], ring[(k + 1) % 6]});
+  tris.push_back({tris[3][0], tris[3][2], tris[3][1]});  // reversed copy of triangle 3
+  tris.push_back({Vec3f{0, 0, 0}, Vec3f{1, 1, 1}, Vec3f{2, 2, 2}});  // collinear
+  tris.push_back({Vec3f{0, 0, 0.5f}, Vec3f{std::numeric_limits<float>::infinity(), 0, 0.5f}, Vec3f{0, 1, 0.5f}});
+  const TriangleSoup s = soup_of(tris);
+  REQUIRE(s.degenerate_count() == 2);
+  const CertifiedIntersector c(s);
+  REQUIRE(c.staged());
+  std::vector<std::uint32_t> all(s.size());
+  std::vector<std::uint32_t> live;
+  for (std::uint32_t i = 0; i < s.size(); ++i) {
+    all[i] = i;
+    if (!s.is_degenerate(i)) live.push_back(i);
+  }
+  RayCounters counters;
+  int hits = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3f o = p() * 3.0f;
+    Vec3f target;
+    switch (i % 4) {
+      case 0: target = v; break;                               // the fan's shared vertex
+      case 1: target = ring[std::size_t(i) % 6]; break;        // a ring vertex
+      case 2: target = (v + ring[std::size_t(i) % 6]) * 0.5f; break;  // an edge
+      default: {
+        const auto& t = tris[std::size_t(i) % 40];
+        target = (t[0] + t[1] + t[2]) * (1.0f / 3.0f) + p() * 0.1f;
+      }
+    }
+    Ray r = make_ray(o, target - o, i % 3 == 0 ? -1.0f : 0.0f);
+    if (i % 7 == 0) r.tfar = 1.0f;  // t of the aimed point is about 1
+    if (i % 11 == 0) r.tnear = 1.0f;
+    // Leaves of 1 to 6 triangles, in a random order, with one triangle listed twice.
+    std::shuffle(all.begin(), all.end(), rng);
+    std::vector<std::vector<std::uint32_t>> leaves;
+    for (std::size_t k = 0; k < all.size();) {
+      const std::size_t n = std::min<std::size_t>(all.size() - k, 1 + std::size_t(rng() % 6));
+      leaves.emplace_back(all.begin() + std::ptrdiff_t(k), all.begin() + std::ptrdiff_t(k + n));
+      k += n;
+    }
+    leaves.push_back({all[0], all[1]});
+    require_staged_equals_intersector(c, s, r, leaves, counters);
+    const Hit want = reference_nearest(s, r, live);  // the rational reference takes finite corners only
+    hits += want.hit();
+    NearestHit staged;
+    for (const auto& leaf : leaves) {
+      std::vector<LeafTriangle> corners;
+      for (const std::uint32_t q : leaf) corners.push_back({s.corner(q, 0), s.corner(q, 1), s.corner(q, 2)});
+      detail::exact_leaf_staged(c, r, leaf.data(), corners.data(), std::uint32_t(leaf.size()), staged, nullptr);
+    }
+    require_same(staged.hit, want);
+  }
+  CHECK(hits > 1000);
+  CHECK(counters.exact_decisions > 0);  // the fan's exact zeros went to the intersector
+  CHECK(counters.rule_decisions > 0);
+  // With the filter hook on, the staged path hands every triangle over.
+  CertifiedIntersector::set_filter_off_for_testing(7);
+  const Ray r = make_ray(Vec3f{0.1f, 0.1f, 3.0f}, v - Vec3f{0.1f, 0.1f, 3.0f});
+  RayCounters off;
+  require_staged_equals_intersector(c, s, r, {all}, off);
+  CertifiedIntersector::set_filter_off_for_testing(0);
+  CHECK(off.exact_decisions > 0);
 }
 
 }  // namespace bsprt

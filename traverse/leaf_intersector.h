@@ -51,10 +51,21 @@ struct LeafTriangle {
   Vec3f v[3];
 };
 
+/// Tests only, single-threaded (CertifiedIntersector::set_filter_off_for_testing):
+/// bit k set sends weight k to the rules and the exact stage even when the
+/// double filter decided it; while it is non-zero, traversals call the
+/// intersector for every triangle (exact_double_stage.h). 0 = off.
+inline unsigned exact_filter_off_for_testing = 0;
+
 /// Tests leaf triangles with exact decisions; thread-safe, stateless per call.
 class LeafIntersector {
  public:
   virtual ~LeafIntersector() = default;
+  /// True when every triangle that the inline double stage of
+  /// exact_double_stage.h decides is decided by intersect() the same way, so
+  /// a traversal may decide those itself (detail::exact_leaf_staged) and call
+  /// intersect() for the rest only.
+  bool staged() const { return staged_; }
   /// Short name for reports ("certified").
   virtual std::string name() const = 0;
   /// Tests the triangles `prims` (triangle numbers of the scene it was made
@@ -70,6 +81,9 @@ class LeafIntersector {
                  RayCounters* counters) const {
     intersect(ray, prims, nullptr, best, counters);
   }
+
+ protected:
+  bool staged_ = false;  ///< see staged()
 };
 
 }  // namespace bsprt

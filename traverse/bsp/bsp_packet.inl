@@ -22,6 +22,7 @@
 #include <span>
 
 #include "traverse/bsp/bsp_kernel.h"
+#include "traverse/exact_double_stage.h"
 #include "traverse/simd/watertight_packet.h"
 
 namespace bsprt::simd {
@@ -106,12 +107,12 @@ template <int W>
 inline void packet_exact_leaf(const BspView& v, const CompactBspSlot& n, const Ray* rays, NearestHit* nearest,
                               PacketHit<W>& hit, vmask<W> active) {
   const std::uint32_t first = n.prim_offset();
-  const std::span<const std::uint32_t> prims(v.prims + first, n.prim_count());
   alignas(64) float t[W];
   store<W>(t, hit.t);
   for (unsigned m = movemask<W>(active); m != 0; m &= m - 1) {
     const int lane = std::countr_zero(m);
-    v.exact_leaf->intersect(rays[lane], prims, v.triangles + first, nearest[lane], nullptr);
+    detail::exact_leaf_staged(*v.exact_leaf, rays[lane], v.prims + first, v.triangles + first, n.prim_count(),
+                              nearest[lane], nullptr);
     t[lane] = cull_bound(nearest[lane]);
   }
   hit.t = load<W>(t);

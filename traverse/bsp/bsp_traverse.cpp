@@ -14,6 +14,7 @@
 
 #include "bsprt/error.h"
 #include "traverse/bsp/bsp_kernel.h"
+#include "traverse/exact_double_stage.h"
 #include "traverse/simd/cpu_features.h"
 #include "traverse/simd/simd.h"
 #include "traverse/stack_step.h"
@@ -31,17 +32,31 @@ constexpr int kTopStackSize = 3 * 64 + 4;
 /// A far child waiting on the stack with the ray's (conservative) interval.
 using detail::StackEntry;
 
+/// Per-ray constants of the leaf test: the watertight shear for float
+/// leaves, the double filter's for exact ones (exact_double_stage.h). Only
+/// the one the tracer uses is made, once per ray.
+struct LeafRay {
+  WatertightRay wr;
+  detail::ExactRayConst er;
+};
+inline void leaf_ray_setup(const BspView& v, const Ray& ray, LeafRay& lr) {
+  if (v.exact_leaf)
+    lr.er = detail::exact_ray_const(ray);
+  else
+    lr.wr = watertight_precompute(ray);
+}
+
 /// Tests the triangles of a leaf (ties keep the earlier triangle). With an
 /// exact leaf test, `nearest` keeps the exact order and the answer; hit then
 /// holds its prim and, as t, the cull bound (cull_bound).
 template <bool kCount>
-inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray& ray, const WatertightRay& wr,
+inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray& ray, const LeafRay& lr,
                            Hit& hit, NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if constexpr (kCount) ++c->leaf_visits;
   if (v.exact_leaf) {
-    v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, n.prim_count()),
-                            v.triangles + first, nearest, kCount ? c : nullptr);
+    detail::exact_leaf_staged(*v.exact_leaf, ray, lr.er, v.prims + first, v.triangles + first, n.prim_count(),
+                              nearest, kCount ? c : nullptr);
     hit.prim = nearest.hit.prim;
     hit.t = cull_bound(nearest);
     return;
@@ -49,7 +64,7 @@ inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray&
   if constexpr (kCount) c->triangle_tests += n.prim_count();
   for (std::uint32_t i = first; i < end; ++i) {
     const BspTriangle& t = v.triangles[i];
-    intersect_watertight_closest(wr, t.v[0], t.v[1], t.v[2], v.prims[i], hit);
+    intersect_watertight_closest(lr.wr, t.v[0], t.v[1], t.v[2], v.prims[i], hit);
   }
 }
 
@@ -76,7 +91,7 @@ inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near
 /// triangle (not stored, bsp_compact.h); a popped cell is skipped when it
 /// starts past the nearest hit. bsp_packet.inl repeats these steps.
 template <bool kCount>
-inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray& ray, const WatertightRay& wr,
+inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray& ray, const LeafRay& lr,
                              std::uint32_t root, float tmin, float tmax, Hit& hit, NearestHit& nearest,
                              RayCounters* c) {
   StackEntry stack[kBspMaxDepth];
@@ -103,7 +118,7 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       n = &v.nodes[node];
     }
     if (leaf) {
-      intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
+      intersect_leaf<kCount>(v, *n, ray, lr, hit, nearest, c);
       best = detail::hit_bound(rc, hit.t);
     }
     if (!detail::pop_before(stack, sp, best, node, tmin, tmax)) return;
@@ -111,21 +126,22 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
 }
 
 /// One ray: counts it, makes its constants, and unless it is invalid or
-/// misses the root box hands them to walk(rc, wr, hit, nearest).
+/// misses the root box hands them to walk(rc, lr, hit, nearest).
 template <bool kCount, typename Walk>
 inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& walk) {
   Hit hit;
   if constexpr (kCount) ++c->rays;
   const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
   if (!rc.live) return hit;
-  const WatertightRay wr = watertight_precompute(ray);
+  LeafRay lr;
+  leaf_ray_setup(v, ray, lr);
   NearestHit nearest;
   if constexpr (kCount) {
     const std::uint64_t before = c->exact_decisions;  // set by an exact leaf test
-    walk(rc, wr, hit, nearest);
+    walk(rc, lr, hit, nearest);
     c->exact_rays += c->exact_decisions != before;
   } else {
-    walk(rc, wr, hit, nearest);
+    walk(rc, lr, hit, nearest);
   }
   return v.exact_leaf ? nearest.hit : hit;
 }
@@ -133,9 +149,9 @@ inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& wa
 /// One ray through the whole tree.
 template <bool kCount>
 Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
-  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const WatertightRay& wr, Hit& hit,
+  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const LeafRay& lr, Hit& hit,
                                           NearestHit& nearest) {
-    traverse_subtree<kCount>(v, rc, ray, wr, 0, rc.tmin, rc.tmax, hit, nearest, c);
+    traverse_subtree<kCount>(v, rc, ray, lr, 0, rc.tmin, rc.tmax, hit, nearest, c);
   });
 }
 
@@ -146,7 +162,7 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
 /// the certified steps from its root.
 template <bool kCount>
 inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayConst& rc, const Ray& ray,
-                     const WatertightRay& wr, Hit& hit, NearestHit& nearest, RayCounters* c) {
+                     const LeafRay& lr, Hit& hit, NearestHit& nearest, RayCounters* c) {
   using V = simd::vfloat<4>;
   struct Entry {
     std::uint32_t ref;
@@ -167,7 +183,7 @@ inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayCons
   float best = detail::hit_bound(rc, hit.t);  // the nearest hit in the traversal's parameter; changes in subtrees only
   for (;;) {
     if ((cur.ref & BoxTopNode::kSubtree) != 0) {
-      traverse_subtree<kCount>(v, rc, ray, wr, cur.ref & ~BoxTopNode::kSubtree, cur.tmin,
+      traverse_subtree<kCount>(v, rc, ray, lr, cur.ref & ~BoxTopNode::kSubtree, cur.tmin,
                                cur.tmax < best ? cur.tmax : best, hit, nearest, c);
       best = detail::hit_bound(rc, hit.t);
     } else {
@@ -235,9 +251,9 @@ inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayCons
 /// One ray through the box top and the subtrees under it.
 template <bool kCount>
 Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCounters* c) {
-  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const WatertightRay& wr, Hit& hit,
+  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const LeafRay& lr, Hit& hit,
                                           NearestHit& nearest) {
-    walk_top<kCount>(v, nodes, rc, ray, wr, hit, nearest, c);
+    walk_top<kCount>(v, nodes, rc, ray, lr, hit, nearest, c);
   });
 }
 
@@ -252,9 +268,9 @@ struct WideRay {
   const Ray* ray;
   const Bvh8Subtree* subtrees;
   bool set_up = false;
-  bool sheared = false;
+  bool leaf_set_up = false;  ///< lr made
   BspRayConst rc;    ///< made at the first subtree the ray enters
-  WatertightRay wr;  ///< made at the first float leaf test
+  LeafRay lr;        ///< made at the first subtree the ray enters
 };
 
 /// Subtree `index` under the BVH8 top: the ray's interval clipped to the
@@ -286,8 +302,8 @@ void wide_subtree(WideRay& w, std::uint32_t index, Hit& hit, NearestHit& nearest
   float tmax = exit < rc.tmax ? exit : rc.tmax;
   tmax = tmax < best ? tmax : best;
   if (!(tmin <= tmax)) return;
-  if (!exact && !w.sheared) w.wr = watertight_precompute(*w.ray), w.sheared = true;
-  traverse_subtree<kCount>(*w.v, rc, *w.ray, w.wr, w.subtrees[index].slot, tmin, tmax, h, nearest, c);
+  if (!w.leaf_set_up) leaf_ray_setup(*w.v, *w.ray, w.lr), w.leaf_set_up = true;
+  traverse_subtree<kCount>(*w.v, rc, *w.ray, w.lr, w.subtrees[index].slot, tmin, tmax, h, nearest, c);
 }
 
 void wide_subtree_call(void* ctx, std::uint32_t index, Hit& hit, NearestHit& nearest, RayCounters* c) {
@@ -322,7 +338,7 @@ inline float select_bits(std::uint32_t mask, float a, float b) {
 /// between steps.
 struct Lane {
   BspRayConst rc;
-  WatertightRay wr;
+  LeafRay lr;
   Hit hit;
   NearestHit nearest;  ///< exact leaf tests only
   const Ray* ray;
@@ -364,7 +380,7 @@ inline bool lane_step(const BspView& v, Lane& L) {
     L.pop = (go_near | go_far) ^ 1u;
     return false;
   }
-  if (L.pop == 0) intersect_leaf<false>(v, *n, *L.ray, L.wr, L.hit, L.nearest, nullptr);
+  if (L.pop == 0) intersect_leaf<false>(v, *n, *L.ray, L.lr, L.hit, L.nearest, nullptr);
   const float best = detail::hit_bound(L.rc, L.hit.t);
   for (;;) {
     if (L.sp == 0) return true;
@@ -396,7 +412,7 @@ void trace_interleaved(const BspView& v, const Ray* rays, std::size_t count, Hit
         hits[i] = Hit{};
         continue;
       }
-      L.wr = watertight_precompute(rays[i]);
+      leaf_ray_setup(v, rays[i], L.lr);
       L.hit = Hit{};
       L.nearest = NearestHit{};
       L.ray = &rays[i];

@@ -30,6 +30,7 @@
 #include <span>
 
 #include "traverse/bvh/bvh8_kernel.h"
+#include "traverse/exact_double_stage.h"
 #include "traverse/exact_prefilter.h"
 #include "traverse/simd/simd.h"
 #include "traverse/watertight.h"
@@ -298,8 +299,8 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
         const unsigned lanes =
             filter ? exact_lanes(wr, v.leaf_soa + 9 * std::size_t(first), count) : (1u << count) - 1u;
         if (lanes == (1u << count) - 1u) {
-          v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(v.prims + first, count), v.triangles + first,
-                                  nearest, kCount ? c : nullptr);
+          exact_leaf_staged(*v.exact_leaf, ray, v.prims + first, v.triangles + first, count, nearest,
+                            kCount ? c : nullptr);
         } else if (lanes != 0) {
           std::uint32_t p[4];
           LeafTriangle t[4];
@@ -309,7 +310,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
             p[n] = v.prims[first + i];
             t[n] = v.triangles[first + i];
           }
-          v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(p, n), t, nearest, kCount ? c : nullptr);
+          exact_leaf_staged(*v.exact_leaf, ray, p, t, n, nearest, kCount ? c : nullptr);
         }
         if constexpr (kCount) c->triangle_tests += count - std::uint32_t(__builtin_popcount(lanes));
         if (kAnyHit && nearest.hit.hit()) return nearest.hit;

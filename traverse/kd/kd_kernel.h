@@ -12,6 +12,7 @@
 #include "bsprt/ray.h"
 #include "traverse/counters.h"
 #include "traverse/kd/kd_traverse.h"
+#include "traverse/exact_double_stage.h"
 #include "traverse/exact_prefilter.h"
 #include "traverse/simd/simd.h"
 #include "traverse/watertight.h"
@@ -68,7 +69,7 @@ inline void kd_exact_leaf(const KdView& v, std::uint32_t first, std::uint32_t en
       std::memcpy(static_cast<void*>(corners + m), &v.triangles[prims[m]], sizeof(LeafTriangle));
     }
     if (c) c->triangle_tests += n - m;
-    if (m) v.exact_leaf->intersect(ray, std::span<const std::uint32_t>(prims, m), corners, nearest, c);
+    if (m) exact_leaf_staged(*v.exact_leaf, ray, prims, corners, m, nearest, c);
   }
 }
 
