@@ -385,10 +385,16 @@ TEST_CASE("staged exact leaf: equals the certified intersector, field for field 
   CHECK(hits > 1000);
   CHECK(counters.exact_decisions > 0);  // the fan's exact zeros went to the intersector
   CHECK(counters.rule_decisions > 0);
-  // With the filter hook on, the staged path hands every triangle over.
+  // A ray through the inside of a random triangle needs no exact decision;
+  // with the filter hook on, the staged path must still hand its triangles
+  // to the exact stage (it would bypass the hook otherwise).
+  const auto& t0 = tris[0];
+  const Vec3f o0{0.05f, -0.1f, 3.0f}, aim = (t0[0] + t0[1] + t0[2]) * (1.0f / 3.0f);
+  const Ray r = make_ray(o0, aim - o0);
+  RayCounters on, off;
+  require_staged_equals_intersector(c, s, r, {all}, on);
+  CHECK(on.exact_decisions == 0);
   CertifiedIntersector::set_filter_off_for_testing(7);
-  const Ray r = make_ray(Vec3f{0.1f, 0.1f, 3.0f}, v - Vec3f{0.1f, 0.1f, 3.0f});
-  RayCounters off;
   require_staged_equals_intersector(c, s, r, {all}, off);
   CertifiedIntersector::set_filter_off_for_testing(0);
   CHECK(off.exact_decisions > 0);
