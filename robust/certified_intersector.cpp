@@ -23,25 +23,7 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 using detail::ExactRayConst;
 using detail::Stage;
-
-struct D3 {
-  double x, y, z;
-};
-D3 dsub(const Vec3f& a, const Vec3f& b) {
-  return {double(a.x) - double(b.x), double(a.y) - double(b.y), double(a.z) - double(b.z)};
-}
-
-/// Whether a - b (floats) is exact in double: Knuth's two-sum error is zero.
-bool exact_difference(float a, float b) {
-  const double x = a, y = -double(b), s = x + y, yv = s - x, xv = s - yv;
-  return (x - xv) + (y - yv) == 0.0;
-}
-/// Whether a - o == ±d exactly (a vertex on the ray's line through o + d, or o - d).
-bool exactly_on_direction(const Vec3f& v, const Vec3f& o, const D3& a, const D3& d) {
-  const bool same = a.x == d.x && a.y == d.y && a.z == d.z, opposite = a.x == -d.x && a.y == -d.y && a.z == -d.z;
-  return (same || opposite) && exact_difference(v.x, o.x) && exact_difference(v.y, o.y) &&
-         exact_difference(v.z, o.z);
-}
+using detail::same_point;
 
 struct M3 {
   Mp x, y, z;
@@ -100,12 +82,6 @@ float round_exact(const ExactT& e, double& lo, double& hi) {
   }
 }
 
-/// One sign for all three weights, not all zero: the line meets the triangle.
-bool meets(int su, int sv, int sw) {
-  const bool neg = su < 0 || sv < 0 || sw < 0, pos = su > 0 || sv > 0 || sw > 0;
-  return !(neg && pos) && (neg || pos);
-}
-
 /// A hit of one triangle: the float t, an enclosure [t_lo, t_hi] of the
 /// exact t, the barycentrics and where on the triangle it lies.
 struct Candidate {
@@ -152,16 +128,8 @@ std::optional<Candidate> test_one(const Ray& ray, const ExactRayConst& fr, const
       if ((exact_filter_off_for_testing >> k) & 1u) s[k] = 2;
   }
   if (s[0] == 2 || s[1] == 2 || s[2] == 2) {
-    // A vertex exactly on the ray's line through o + d: the two weights that
-    // pair it with d are triple products with a repeated vector, exactly 0.
-    const D3 a[3] = {dsub(tri[0], ray.org), dsub(tri[1], ray.org), dsub(tri[2], ray.org)};
-    const D3 d{fr.d[0], fr.d[1], fr.d[2]};
-    bool rule = false;
-    for (int i = 0; i < 3; ++i) {
-      if (!exactly_on_direction(tri[i], ray.org, a[i], d)) continue;
-      for (int k = 0; k < 3; ++k)
-        if (k != i && s[k] == 2) s[k] = 0, w[k] = 0.0, rule = true;
-    }
+    // Rule (a): a vertex exactly on the ray's line through o + d or o - d.
+    const bool rule = detail::vertex_rule(fr, ray, floats, sw);
     if (s[0] == 2 || s[1] == 2 || s[2] == 2) {  // exact stage for what is still open
       ++st.exact;
       const M3 e0 = msub(tri[0], ray.org), e1 = msub(tri[1], ray.org), e2 = msub(tri[2], ray.org), ed = mvec(ray.dir);
@@ -182,20 +150,11 @@ std::optional<Candidate> test_one(const Ray& ray, const ExactRayConst& fr, const
     for (int k = 0; k < 3; ++k)
       if (s[k] == 0) s[k] = sos_sign(tri[(k + 1) % 3], tri[(k + 2) % 3], ray.dir);
   }
-  if (!meets(s[0], s[1], s[2])) return std::nullopt;
+  if (!detail::meets(sw.s)) return std::nullopt;
 
   Candidate c;
   c.sign = (s[0] > 0 || s[1] > 0 || s[2] > 0) ? 1 : -1;
-  const int zeros = int(s[0] == 0) + int(s[1] == 0) + int(s[2] == 0);
-  if (zeros == 2) {
-    c.on = 1;
-    c.p = tri[s[0] != 0 ? 0 : (s[1] != 0 ? 1 : 2)];
-  } else if (zeros == 1) {
-    const int k = s[0] == 0 ? 0 : (s[1] == 0 ? 1 : 2);  // the edge opposite vertex k
-    c.on = 2;
-    c.p = tri[(k + 1) % 3];
-    c.q = tri[(k + 2) % 3];
-  }
+  detail::hit_place(sw.s, floats, c.on, c.p, c.q);
   detail::stage_barycentrics(sw.w, c.u, c.v);
 
   // t in double with its static bound (exact_double_stage.h), else exactly.
@@ -213,8 +172,6 @@ std::optional<Candidate> test_one(const Ray& ray, const ExactRayConst& fr, const
   return c;
 }
 
-bool same_point(const Vec3f& a, const Vec3f& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-
 /// Whether two triangles have the same three corners (in any order).
 bool same_corners(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b) {
   for (const Vec3f& x : a)
@@ -228,9 +185,7 @@ bool same_corners(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b) 
 /// arithmetic: the same vertex, the same edge, or triangles with the same corners.
 bool same_t_by_rule(const Candidate& c, const std::array<Vec3f, 3>& tri, const NearestHit& best,
                     const std::array<Vec3f, 3>& best_tri) {
-  if (c.on == 1 && best.on == 1) return same_point(c.p, best.p);
-  if (c.on == 2 && best.on == 2)
-    return (same_point(c.p, best.p) && same_point(c.q, best.q)) || (same_point(c.p, best.q) && same_point(c.q, best.p));
+  if ((c.on == 1 && best.on == 1) || (c.on == 2 && best.on == 2)) return detail::same_place(c.on, c.p, c.q, best);
   return same_corners(tri, best_tri);
 }
 

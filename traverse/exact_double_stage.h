@@ -173,67 +173,190 @@ inline void stage_barycentrics(const double (&w)[3], float& u, float& v) {
   v = float(w[2] * inv);
 }
 
+/// Whether a - b (floats) is exact in double: Knuth's two-sum error is zero.
+inline bool exact_difference(float a, float b) {
+  const double x = a, y = -double(b), s = x + y, yv = s - x, xv = s - yv;
+  return (x - xv) + (y - yv) == 0.0;
+}
+
+/// Rule (a) on exact zeros (docs/exact-leaf-test.md, "Rules on exact zeros"):
+/// a corner v_i with v_i - o == ±d exactly (each difference exact in double)
+/// makes the two weights that pair it with d exactly 0; those of them still
+/// open (s == 2) become 0. True when the rule set any. Only a corner whose two
+/// weights are both open can qualify: a decided sign is never an exact 0.
+inline bool vertex_rule(const ExactRayConst& fr, const Ray& ray, const std::array<float, 9>& c, StageWeights& sw) {
+  const float o[3] = {ray.org.x, ray.org.y, ray.org.z};
+  const bool open[3] = {sw.s[0] == 2, sw.s[1] == 2, sw.s[2] == 2};
+  bool rule = false;
+  for (int i = 0; i < 3; ++i) {
+    if (!open[i == 0 ? 1 : 0] || !open[i == 2 ? 1 : 2]) continue;
+    const double a[3] = {double(c[3 * i]) - double(o[0]), double(c[3 * i + 1]) - double(o[1]),
+                         double(c[3 * i + 2]) - double(o[2])};
+    const bool same = a[0] == fr.d[0] && a[1] == fr.d[1] && a[2] == fr.d[2];
+    const bool opposite = a[0] == -fr.d[0] && a[1] == -fr.d[1] && a[2] == -fr.d[2];
+    if (!(same || opposite)) continue;
+    if (!exact_difference(c[3 * i], o[0]) || !exact_difference(c[3 * i + 1], o[1]) ||
+        !exact_difference(c[3 * i + 2], o[2]))
+      continue;
+    for (int k = 0; k < 3; ++k)
+      if (k != i && sw.s[k] == 2) sw.s[k] = 0, sw.w[k] = 0.0, rule = true;
+  }
+  return rule;
+}
+
+/// One sign for all three weights, not all zero: the line meets the triangle.
+inline bool meets(const int (&s)[3]) {
+  const bool neg = s[0] < 0 || s[1] < 0 || s[2] < 0, pos = s[0] > 0 || s[1] > 0 || s[2] > 0;
+  return !(neg && pos) && (neg || pos);
+}
+
+/// Where a hit with decided signs `s` lies on its triangle (NearestHit::on,
+/// p, q): at the corner whose weight is the only non-zero one, on the edge
+/// opposite the corner whose weight is the only zero one, else inside.
+inline void hit_place(const int (&s)[3], const std::array<float, 9>& c, std::uint8_t& on, Vec3f& p, Vec3f& q) {
+  const auto corner = [&](int i) { return Vec3f{c[3 * i], c[3 * i + 1], c[3 * i + 2]}; };
+  const int zeros = int(s[0] == 0) + int(s[1] == 0) + int(s[2] == 0);
+  on = 0, p = Vec3f{}, q = Vec3f{};
+  if (zeros == 2) {
+    on = 1;
+    p = corner(s[0] != 0 ? 0 : (s[1] != 0 ? 1 : 2));
+  } else if (zeros == 1) {
+    const int k = s[0] == 0 ? 0 : (s[1] == 0 ? 1 : 2);  // the edge opposite corner k
+    on = 2;
+    p = corner((k + 1) % 3);
+    q = corner((k + 2) % 3);
+  }
+}
+
+inline bool same_point(const Vec3f& a, const Vec3f& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+/// Rule (b) on exact zeros for two hits placed on a corner or an edge: the
+/// same corner, or the same edge in either order, means the same exact t.
+inline bool same_place(std::uint8_t on, const Vec3f& p, const Vec3f& q, const NearestHit& best) {
+  if (on == 1 && best.on == 1) return same_point(p, best.p);
+  if (on == 2 && best.on == 2)
+    return (same_point(p, best.p) && same_point(q, best.q)) || (same_point(p, best.q) && same_point(q, best.p));
+  return false;
+}
+
 /// The corners of a leaf triangle as nine floats (v0, v1, v2).
 inline std::array<float, 9> corner_floats(const LeafTriangle& t) { return std::bit_cast<std::array<float, 9>>(t); }
 
-/// LeafIntersector::intersect(ray, prims[0..count), corners, best, counters),
-/// with the double stage inline when the intersector allows it
-/// (LeafIntersector::staged()): a triangle whose weights and t the double
-/// stage decides, and whose t enclosure is clear of the nearest hit's, is
-/// settled here; any other goes to the intersector alone. The intersector
-/// decides such a triangle the same way (it runs these functions first) and
-/// keeps the nearest by the same comparisons, so the answer, the enclosure
-/// and the counters are its own. `ray` must be valid.
-/// `fr` = exact_ray_const(ray), made once per ray by the caller.
-inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
-                              const std::uint32_t* prims, const LeafTriangle* corners, std::uint32_t count,
-                              NearestHit& best, RayCounters* c) {
+/// LeafIntersector::intersect(ray, prims[0..count), corners, best, counters)
+/// (corners from `corner`, below), with the double stage and the rules on exact zeros inline when the
+/// intersector allows it (LeafIntersector::staged()). A triangle is settled
+/// here when the double stage, with rule (a) for what it leaves open, decides
+/// its weights and its t, and its t enclosure is clear of the nearest hit's
+/// or ties with it at the same corner or edge (rule (b)). Any other triangle
+/// (a sign or a t for the exact stage, an overlap only the intersector can
+/// settle) goes to the intersector alone, before anything about it is
+/// counted. The intersector decides a settled triangle the same way (it runs
+/// these functions first, in the same order) and keeps the nearest by the
+/// same comparisons, so the answer, the enclosure and the counters are its
+/// own. `ray` must be valid. `fr` = exact_ray_const(ray), made once per ray by
+/// the caller.
+///
+/// `corner(i)` gives the corners of prims[i] (a const LeafTriangle&): a
+/// traversal that keeps corners by triangle number reads them in place.
+template <class Corner>
+[[gnu::always_inline]] inline void exact_leaf_staged_by(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
+                                 const std::uint32_t* prims, std::uint32_t count, Corner&& corner, NearestHit& best,
+                                 RayCounters* c) {
   if (!x.staged() || exact_filter_off_for_testing != 0) {
-    x.intersect(ray, std::span<const std::uint32_t>(prims, count), corners, best, c);
+    for (std::uint32_t i = 0; i < count; ++i)
+      x.intersect(ray, std::span<const std::uint32_t>(prims + i, 1), &corner(i), best, c);
     return;
   }
-  std::uint64_t tests = 0;
+  std::uint64_t tests = 0, rules = 0;
   for (std::uint32_t i = 0; i < count; ++i) {
     const std::uint32_t prim = prims[i];
-    const auto open = [&] { x.intersect(ray, std::span<const std::uint32_t>(prims + i, 1), corners + i, best, c); };
+    const LeafTriangle& ct = corner(i);
+    const auto open = [&] { x.intersect(ray, std::span<const std::uint32_t>(prims + i, 1), &ct, best, c); };
     if (best.hit.hit() && prim == best.hit.prim) {  // met again in another leaf: not nearer than itself
       ++tests;
       continue;
     }
-    const std::array<float, 9> tri = corner_floats(corners[i]);
+    const std::array<float, 9> tri = corner_floats(ct);
     StageWeights sw;
     const Stage ws = double_weights(fr, tri, sw);
     if (ws == Stage::Miss) {
       ++tests;
       continue;
     }
+    std::uint64_t rule = 0;  // rule (a) decided a sign of this triangle
     if (ws == Stage::Open) {
-      open();
-      continue;
+      if (!vertex_rule(fr, ray, tri, sw) || sw.s[0] == 2 || sw.s[1] == 2 || sw.s[2] == 2) {
+        open();  // a sign for the exact stage
+        continue;
+      }
+      rule = 1;
+      if (!meets(sw.s)) {
+        ++tests, ++rules;
+        continue;
+      }
     }
     float t;
     double lo, hi;
     const Stage ts = double_t(fr, ray, tri, t, lo, hi);
     if (ts == Stage::Miss) {
-      ++tests;
+      ++tests, rules += rule;
       continue;
     }
-    if (ts == Stage::Open || (best.hit.hit() && !(hi < best.t_lo) && !(lo > best.t_hi))) {
-      open();  // t to round exactly, or enclosures that overlap the nearest hit's
+    if (ts == Stage::Open) {
+      open();  // t to round exactly
       continue;
     }
-    ++tests;
-    if (best.hit.hit() && lo > best.t_hi) continue;  // farther
+    std::uint8_t on = 0;  // inside unless rule (a) put a zero in the signs
+    Vec3f p{}, q{};
+    if (rule) hit_place(sw.s, tri, on, p, q);
+    bool nearer;
+    if (!best.hit.hit() || hi < best.t_lo) {
+      nearer = true;
+    } else if (lo > best.t_hi) {
+      nearer = false;
+    } else if (on != 0 && same_place(on, p, q, best)) {  // rule (b): the same exact t
+      ++rule;
+      nearer = prim < best.hit.prim;
+    } else {
+      open();  // enclosures that overlap: the intersector compares them
+      continue;
+    }
+    ++tests, rules += rule;
+    if (!nearer) continue;
     best.hit = Hit{t, prim, 0.0f, 0.0f};
     stage_barycentrics(sw.w, best.hit.u, best.hit.v);
     best.t_lo = lo;
     best.t_hi = hi;
-    best.on = 0;
-    best.p = Vec3f{};
-    best.q = Vec3f{};
+    best.on = on;
+    best.p = p;
+    best.q = q;
   }
-  if (c) c->triangle_tests += tests;
+  if (c) c->triangle_tests += tests, c->rule_decisions += rules;
 }
+
+/// As exact_leaf_staged_by, with the corners of prims[i] at corners[i].
+[[gnu::always_inline]] inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
+                              const std::uint32_t* prims, const LeafTriangle* corners, std::uint32_t count,
+                              NearestHit& best, RayCounters* c) {
+  if (!x.staged() || exact_filter_off_for_testing != 0) {
+    x.intersect(ray, std::span<const std::uint32_t>(prims, count), corners, best, c);
+    return;
+  }
+  exact_leaf_staged_by(x, ray, fr, prims, count, [corners](std::uint32_t i) -> const LeafTriangle& { return corners[i]; },
+                       best, c);
+}
+
+/// The ray's double constants, made on first use (exact_ray_const costs two
+/// divisions): a traversal keeps one per ray and passes it to every leaf, so
+/// a ray whose leaves the float prefilter empties never pays for them.
+struct LazyExactRay {
+  ExactRayConst fr;
+  bool ready = false;
+  const ExactRayConst& get(const Ray& ray) {
+    if (!ready) fr = exact_ray_const(ray), ready = true;
+    return fr;
+  }
+};
 
 /// As above, making the ray's constants for this call.
 inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const std::uint32_t* prims,
