@@ -388,6 +388,99 @@ TEST_CASE("BSP packets equal single rays exactly", "[bsp]") {
   }
 }
 
+TEST_CASE("exact packets: bsp and kd equal their single rays and the exact reference at every width",
+          "[bsp][kd][exact]") {
+  // Exact leaves in packets test each triangle against all lanes in the
+  // packet prefilter (traverse/simd/exact_packet_filter.h) and run the scalar
+  // exact test for the lanes it keeps. Rays through vertices and edges (exact
+  // zeros, rules, ties) and coplanar stacks are where a wrong bound would drop
+  // a lane that hits. Sorted by direction octant, so the kd-tree's packets are
+  // coherent and not traced as single rays.
+  std::vector<std::pair<std::string, TriangleSoup>> scenes;
+  scenes.emplace_back("suzanne", load_mesh(scene_path("suzanne.obj")));
+  scenes.emplace_back("default scene", make_default_scene());
+  scenes.emplace_back("coplanar stack", make_coplanar_stack());
+  scenes.emplace_back("slivers", make_slivers());
+  for (const auto& [name, soup] : scenes) {
+    std::vector<Ray> rays = all_ray_sets(soup, 400, 21);
+    const auto octant = [](const Ray& r) {
+      return int(std::signbit(r.dir.x)) | int(std::signbit(r.dir.y)) << 1 | int(std::signbit(r.dir.z)) << 2;
+    };
+    std::stable_sort(rays.begin(), rays.end(), [&](const Ray& a, const Ray& b) { return octant(a) < octant(b); });
+    std::vector<Hit> ref(rays.size());
+    make_tracer("exact", soup)->trace_batch(rays, ref, 1);
+    std::size_t hits = 0;
+    for (const Hit& h : ref) hits += h.hit();
+    for (const char* accel : {"bsp", "kd"}) {
+      const std::unique_ptr<Accelerator> t = make_tracer(accel, soup);
+      std::vector<Hit> single(rays.size());
+      t->trace_batch(rays, single, 1);
+      std::size_t wrong = 0;
+      for (std::size_t i = 0; i < rays.size(); ++i)
+        wrong += single[i].prim != ref[i].prim || (ref[i].hit() && single[i].t != ref[i].t);
+      INFO(name << ", " << accel);
+      CHECK(wrong == 0);
+      for (int w : {4, 8, 16}) {
+        if (int(detected_isa()) < int(isa_for_width(w))) continue;
+        std::vector<Hit> packed(rays.size());
+        t->trace_batch(rays, packed, w);
+        std::size_t diff = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) diff += std::memcmp(&single[i], &packed[i], sizeof(Hit)) != 0;
+        INFO("width " << w);
+        CHECK(diff == 0);
+      }
+    }
+    CHECK(hits > rays.size() / 4);
+  }
+}
+
+// Found by the test above when it was written: the kd-tree's reciprocal 1/d
+// overflowed to inf for a subnormal direction component, which put every
+// crossing of that axis, the root box's included, at ±inf; a ray that reaches
+// the triangle at t = 2^119 missed it (kd and kd-float, single rays and
+// packets). Now such a reciprocal is NaN, which culls nothing, as in the BSP.
+// The rays are those of "bvh8: a subnormal shear ..." (test_bvh8.cpp), in
+// packets too, where a lane whose shear is subnormal keeps every triangle.
+TEST_CASE("kd and exact packets: a subnormal direction component loses no hit", "[bsp][kd][exact][regression]") {
+  const auto one_triangle = [](Vec3f a, Vec3f b, Vec3f c) {
+    TriangleSoup s;
+    s.vertices = {a, b, c};
+    s.triangles = {{0, 1, 2}};
+    classify_degenerate(s);
+    return s;
+  };
+  const float z = 0x1p120f, w = 1.0f + 9 * 0x1p-13f;
+  const std::pair<TriangleSoup, Vec3f> cases[] = {
+      {one_triangle({0x1p-30f, -1, z}, {0x1p-30f, 1, z}, {0x1.ap-30f, 0, z}), {0x1p-149f, 0, 1.5f}},
+      {one_triangle({-600 * 0x1p-149f, 0, 1}, {513 * 0x1p-149f, 0x1p40f, w}, {512 * 0x1p-149f, -0x1p41f, w}),
+       {0x1p-140f, 0, 1}}};
+  std::vector<std::pair<TriangleSoup, Vec3f>> all(std::begin(cases), std::end(cases));
+  {  // case 1 with a second triangle beside the ray, so that splits on x separate the two
+    TriangleSoup s = cases[0].first;
+    s.vertices.insert(s.vertices.end(), {{-2, -1, 0}, {-1, -1, 0}, {-1.5f, 1, 1}});
+    s.triangles.push_back({3, 4, 5});
+    classify_degenerate(s);
+    all.emplace_back(s, cases[0].second);
+  }
+  for (const auto& [soup, dir] : all) {
+    std::vector<Ray> rays(16);
+    for (Ray& r : rays) r.org = {0, 0, 0}, r.dir = dir;
+    const Hit want = make_tracer("exact", soup)->trace(rays[0]);
+    REQUIRE(want.hit());
+    for (const char* accel : {"bsp", "kd"}) {
+      const std::unique_ptr<Accelerator> t = make_tracer(accel, soup);
+      for (int w : {1, 4, 8, 16}) {
+        if (w > 1 && int(detected_isa()) < int(isa_for_width(w))) continue;
+        std::vector<Hit> got(rays.size());
+        t->trace_batch(rays, got, w);
+        INFO(accel << ", " << soup.size() << " triangles, width " << w << ", direction x " << dir.x << ", got t " << got[0].t << " prim " << got[0].prim
+                   << ", exact t " << want.t);
+        for (const Hit& h : got) CHECK((h.prim == want.prim && h.t == want.t));
+      }
+    }
+  }
+}
+
 TEST_CASE("BSP interleaved single rays equal sequential ones exactly", "[bsp]") {
   const TriangleSoup suzanne = load_mesh(scene_path("suzanne.obj"));
   std::vector<std::pair<std::string, TriangleSoup>> scenes;

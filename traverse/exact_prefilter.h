@@ -44,9 +44,11 @@ inline bool filterable(const WatertightRay& r, const Ray& ray) {
 /// microcode assist (perf: a third of the kd-tree's exact leaf time on
 /// conference camera rays). Test: "exact prefilter: the bound equals its
 /// formula".
-inline simd::vfloat<4> exact_filter_bound(simd::vfloat<4> mx, simd::vfloat<4> my) {
-  const simd::vfloat<4> scaled = simd::max<4>(mx + my, simd::splat<4>(0x1p25f)) * 0x1p-25f;
-  return simd::max<4>(0x1p-18f * (mx * my), scaled * 0x1p-120f);
+/// W lanes at once (W = 4 unless given; the packet filter, exact_packet_filter.h).
+template <int W = 4>
+inline simd::vfloat<W> exact_filter_bound(simd::vfloat<W> mx, simd::vfloat<W> my) {
+  const simd::vfloat<W> scaled = simd::max<W>(mx + my, simd::splat<W>(0x1p25f)) * 0x1p-25f;
+  return simd::max<W>(0x1p-18f * (mx * my), scaled * 0x1p-120f);
 }
 
 /// `rows` holds nine rows of `count` (1..4) floats (corner c, axis k at row

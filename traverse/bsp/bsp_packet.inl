@@ -23,6 +23,7 @@
 
 #include "traverse/bsp/bsp_kernel.h"
 #include "traverse/exact_double_stage.h"
+#include "traverse/simd/exact_packet_filter.h"
 #include "traverse/simd/watertight_packet.h"
 
 namespace bsprt::simd {
@@ -99,23 +100,35 @@ inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count
   return p;
 }
 
-/// The exact leaf test (v.exact_leaf) for each active lane, one ray at a time:
-/// the lane's NearestHit keeps the exact order and the answer, hit.t its
-/// cull bound (cull_bound).
+/// The exact leaf test (v.exact_leaf) for the active lanes: each triangle
+/// against all of them in the packet prefilter (exact_packet_filter.h), then,
+/// in leaf order, the scalar exact test for the lanes it could not prove
+/// missed. A lane sees its triangles in the order the one-ray test sees them,
+/// less certain misses, which change nothing, so its NearestHit (the exact
+/// order and the answer) is the single ray's; hit.t becomes its cull bound
+/// (cull_bound). `er` holds each lane's double constants, made on first use.
 /// Counted runs trace single rays (BspTracer::trace_batch), so no counters here.
 template <int W>
-inline void packet_exact_leaf(const BspView& v, const CompactBspSlot& n, const Ray* rays, NearestHit* nearest,
+inline void packet_exact_leaf(const BspView& v, const CompactBspSlot& n, const WatertightPacket<W>& pre,
+                              vmask<W> filterable, const Ray* rays, NearestHit* nearest, detail::LazyExactRay* er,
                               PacketHit<W>& hit, vmask<W> active) {
-  const std::uint32_t first = n.prim_offset();
-  alignas(64) float t[W];
-  store<W>(t, hit.t);
+  const std::uint32_t first = n.prim_offset(), count = n.prim_count();
+  for (std::uint32_t i = first; i < first + count; ++i) {
+    const BspTriangle& t = v.triangles[i];
+    const unsigned need = movemask<W>(exact_packet_lanes<W>(pre, t.v[0], t.v[1], t.v[2], active, filterable));
+    for (unsigned m = need; m != 0; m &= m - 1) {
+      const int lane = std::countr_zero(m);
+      detail::exact_leaf_staged(*v.exact_leaf, rays[lane], er[lane].get(rays[lane]), v.prims + i,
+                                v.triangles + i, 1, nearest[lane], nullptr);
+    }
+  }
+  alignas(64) float tl[W];
+  store<W>(tl, hit.t);
   for (unsigned m = movemask<W>(active); m != 0; m &= m - 1) {
     const int lane = std::countr_zero(m);
-    detail::exact_leaf_staged(*v.exact_leaf, rays[lane], v.prims + first, v.triangles + first, n.prim_count(),
-                              nearest[lane], nullptr);
-    t[lane] = cull_bound(nearest[lane]);
+    tl[lane] = cull_bound(nearest[lane]);
   }
-  hit.t = load<W>(t);
+  hit.t = load<W>(tl);
 }
 
 template <int W, bool kCount>
@@ -152,8 +165,9 @@ inline vmask<W> cut_node(const CompactBspSlot& n, const BspPacketRay<W>& r, vflo
 /// frames the scene never reach one.
 template <int W, bool kCount>
 void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit, RayCounters* c,
-                  const Ray* rays = nullptr, NearestHit* nearest = nullptr) {
+                  const Ray* rays = nullptr, NearestHit* nearest = nullptr, detail::LazyExactRay* er = nullptr) {
   WatertightPacket<W> pre;
+  vmask<W> filterable{};  // exact leaves: lanes the packet prefilter may leave out
   bool have_pre = false;
   vfloat<W> tmin = r.tmin, tmax = r.tmax;
   vmask<W> active = r.live;
@@ -212,14 +226,16 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
       }
       n = &v.nodes[node];
     }
-    if (leaf && nearest) {
-      packet_exact_leaf<W>(v, *n, rays, nearest, hit, active);
-    } else if (leaf) {
+    if (leaf) {
       if (!have_pre) {
         pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
+        if (nearest) filterable = filterable_lanes<W>(pre, r.dir);
         have_pre = true;
       }
-      packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
+      if (nearest)
+        packet_exact_leaf<W>(v, *n, pre, filterable, rays, nearest, er, hit, active);
+      else
+        packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
     }
     // Each lane's nearest hit in its traversal parameter (detail::hit_bound).
     const vfloat<W> best =
@@ -246,7 +262,8 @@ void trace_packets(const BspView& v, const Ray* rays, std::size_t n, Hit* hits, 
     PacketHit<W> hit = packet_miss<W>();
     if (v.exact_leaf) {  // exact leaves: never counted here (see packet_exact_leaf)
       NearestHit nearest[W];
-      if (any<W>(r.live)) trace_packet<W, false>(v, r, hit, nullptr, rays + base, nearest);
+      detail::LazyExactRay er[W];
+      if (any<W>(r.live)) trace_packet<W, false>(v, r, hit, nullptr, rays + base, nearest, er);
       for (int i = 0; i < count; ++i) hits[base + std::size_t(i)] = nearest[i].hit;
       continue;
     }

@@ -4,8 +4,10 @@
 /// and the per-ISA packet kernels (kd_packet.inl) share, the interval widening
 /// constants both must use identically, and the kernel entry points.
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <span>
 #include <type_traits>
 
@@ -23,6 +25,17 @@ namespace bsprt::detail {
 /// more than the <= 3 ulps of error of (split - o) * (1/d) and of its rounding.
 inline constexpr float kKdTLo = 1.0f - 0x1p-21f;
 inline constexpr float kKdTHi = 1.0f + 0x1p-21f;
+
+/// 1/d for the traversal: NaN when d is subnormal. Then 1/d may overflow
+/// while the crossings (s - o)/d are still finite, and an infinite reciprocal
+/// would put every crossing of that axis at ±inf and cull the cells the ray
+/// reaches at a finite t. A NaN crossing culls nothing (both children, the
+/// whole interval), as in the BSP's setup (bsp_kernel.h, ray_setup_core).
+/// Regression test "exact packets: bsp and kd equal ... the exact reference"
+/// (tests/test_bsp_traverse.cpp, the subnormal-shear rays).
+inline float kd_reciprocal(float d) {
+  return (d == 0.0f || std::fabs(d) >= 0x1p-126f) ? 1.0f / d : std::numeric_limits<float>::quiet_NaN();
+}
 
 /// Raw pointers into a KdTracer, for kernels that must not instantiate std::
 /// templates compiled for their ISA.

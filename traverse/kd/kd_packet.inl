@@ -13,9 +13,11 @@
 
 #include <bit>
 #include <cstdint>
+#include <limits>
 #include <span>
 
 #include "traverse/kd/kd_kernel.h"
+#include "traverse/simd/exact_packet_filter.h"
 #include "traverse/simd/watertight_packet.h"
 
 namespace bsprt::simd {
@@ -62,22 +64,36 @@ inline void widen(vfloat<W> t, vfloat<W>& lo, vfloat<W>& hi) {
   hi = a > b ? a : b;
 }
 
-/// The exact leaf test (v.exact_leaf) for each active lane, one ray at a time:
-/// the lane's NearestHit keeps the exact order and the answer, hit.t its cull
-/// bound (cull_bound). Never counted (counted runs trace single rays).
+/// The exact leaf test (v.exact_leaf) for the active lanes: each triangle
+/// against all of them in the packet prefilter (exact_packet_filter.h), then,
+/// in leaf order, the scalar exact test for the lanes it could not prove
+/// missed. A lane sees its triangles in the order the one-ray test sees them,
+/// less certain misses, which change nothing, so its NearestHit (the exact
+/// order and the answer) is the single ray's; hit.t becomes its cull bound
+/// (cull_bound). `er` holds each lane's double constants, made on first use.
+/// Never counted (counted runs trace single rays).
 template <int W>
-inline void packet_exact_leaf(const KdView& v, const KdNode& n, const Ray* rays, NearestHit* nearest,
-                              PacketHit<W>& hit, vmask<W> active) {
+inline void packet_exact_leaf(const KdView& v, const KdNode& n, const WatertightPacket<W>& pre, vmask<W> filterable,
+                              const Ray* rays, NearestHit* nearest, detail::LazyExactRay* er, PacketHit<W>& hit,
+                              vmask<W> active) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
-  alignas(64) float t[W];
-  store<W>(t, hit.t);
+  for (std::uint32_t i = first; i < end; ++i) {
+    const std::uint32_t p = v.prims[i];
+    const KdTriangle& t = v.triangles[p];
+    const unsigned need = movemask<W>(exact_packet_lanes<W>(pre, t.v[0], t.v[1], t.v[2], active, filterable));
+    for (unsigned m = need; m != 0; m &= m - 1) {
+      const int lane = std::countr_zero(m);
+      detail::exact_leaf_staged(*v.exact_leaf, rays[lane], er[lane].get(rays[lane]), v.prims + i, &t, 1,
+                                nearest[lane], nullptr);
+    }
+  }
+  alignas(64) float tl[W];
+  store<W>(tl, hit.t);
   for (unsigned m = movemask<W>(active); m != 0; m &= m - 1) {
     const int lane = std::countr_zero(m);
-    const WatertightRay wr = watertight_precompute(rays[lane]);
-    detail::kd_exact_leaf(v, first, end, rays[lane], wr, detail::filterable(wr, rays[lane]), nearest[lane], nullptr);
-    t[lane] = cull_bound(nearest[lane]);
+    tl[lane] = cull_bound(nearest[lane]);
   }
-  hit.t = load<W>(t);
+  hit.t = load<W>(tl);
 }
 
 template <int W, bool kCount>
@@ -108,12 +124,17 @@ struct KdPacketLanes {
 /// that frames the scene never reach one.
 template <int W, bool kCount>
 void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3], PacketHit<W>& hit,
-                  RayCounters* c, const Ray* rays = nullptr, NearestHit* nearest = nullptr) {
+                  RayCounters* c, const Ray* rays = nullptr, NearestHit* nearest = nullptr,
+                  detail::LazyExactRay* er = nullptr) {
   WatertightPacket<W> pre;
+  vmask<W> filterable{};  // exact leaves: lanes the packet prefilter may leave out
   bool have_pre = false;
   const vfloat<W>(&o)[3] = r.o;
   vfloat<W> inv[3], tmin = r.tnear, tmax = r.tfar;
-  for (int k = 0; k < 3; ++k) inv[k] = 1.0f / r.dir[k];  // padding lanes: inf, never active
+  for (int k = 0; k < 3; ++k) {  // detail::kd_reciprocal per lane; padding lanes: inf, never active
+    const vmask<W> normal_or_zero = (r.dir[k] == 0.0f) | (abs<W>(r.dir[k]) >= 0x1p-126f);
+    inv[k] = select<W>(normal_or_zero, 1.0f / r.dir[k], splat<W>(std::numeric_limits<float>::quiet_NaN()));
+  }
   for (int k = 0; k < 3; ++k) {  // clip_root
     const vfloat<W> t0 = (v.bounds.lo[k] - o[k]) * inv[k], t1 = (v.bounds.hi[k] - o[k]) * inv[k];
     vfloat<W> enter, exit, unused;
@@ -153,14 +174,16 @@ void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3],
       }
       n = &v.nodes[node];
     }
-    if (n->is_leaf() && nearest) {
-      packet_exact_leaf<W>(v, *n, rays, nearest, hit, active);
-    } else if (n->is_leaf()) {
+    if (n->is_leaf()) {
       if (!have_pre) {
         pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
+        if (nearest) filterable = filterable_lanes<W>(pre, r.dir);
         have_pre = true;
       }
-      packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
+      if (nearest)
+        packet_exact_leaf<W>(v, *n, pre, filterable, rays, nearest, er, hit, active);
+      else
+        packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
     }
     for (;;) {
       if (sp == 0) return;
@@ -196,7 +219,8 @@ void trace_packets(const KdView& v, const Ray* rays, std::size_t n, Hit* hits, R
     PacketHit<W> hit = packet_miss<W>();
     if (v.exact_leaf) {  // exact leaves: never counted here (see packet_exact_leaf)
       NearestHit nearest[W];
-      if (any<W>(r.valid)) trace_packet<W, false>(v, r, neg, hit, nullptr, rays + base, nearest);
+      detail::LazyExactRay er[W];
+      if (any<W>(r.valid)) trace_packet<W, false>(v, r, neg, hit, nullptr, rays + base, nearest, er);
       for (int i = 0; i < count; ++i) hits[base + std::size_t(i)] = nearest[i].hit;
       continue;
     }
