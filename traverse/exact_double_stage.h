@@ -242,6 +242,73 @@ inline bool same_place(std::uint8_t on, const Vec3f& p, const Vec3f& q, const Ne
 /// The corners of a leaf triangle as nine floats (v0, v1, v2).
 inline std::array<float, 9> corner_floats(const LeafTriangle& t) { return std::bit_cast<std::array<float, 9>>(t); }
 
+/// The staged test's decision for one triangle whose weights the double
+/// stage has computed (`ws`, `sw`, from double_weights), in
+/// exact_leaf_staged_by's order: rule (a) for open signs, then t from
+/// `tstage(t, lo, hi)` (double_t's result, computed on demand or given by a
+/// packet kernel, bit for bit the same), then the nearest hit with rule (b).
+/// Anything the double stage and the rules leave open goes to `open()`
+/// before anything about the triangle is counted. The caller has checked
+/// that prim is not the nearest hit already. `fr()` gives the ray's
+/// ExactRayConst (rule (a) needs it; a packet kernel makes it on demand).
+template <class Fr, class TStage, class Open>
+[[gnu::always_inline]] inline void staged_decide(Fr&& fr, const Ray& ray, std::uint32_t prim,
+                                                 const std::array<float, 9>& tri, Stage ws, StageWeights& sw,
+                                                 TStage&& tstage, Open&& open, NearestHit& best,
+                                                 std::uint64_t& tests, std::uint64_t& rules) {
+  if (ws == Stage::Miss) {
+    ++tests;
+    return;
+  }
+  std::uint64_t rule = 0;  // rule (a) decided a sign of this triangle
+  if (ws == Stage::Open) {
+    if (!vertex_rule(fr(), ray, tri, sw) || sw.s[0] == 2 || sw.s[1] == 2 || sw.s[2] == 2) {
+      open();  // a sign for the exact stage
+      return;
+    }
+    rule = 1;
+    if (!meets(sw.s)) {
+      ++tests, ++rules;
+      return;
+    }
+  }
+  float t;
+  double lo, hi;
+  const Stage ts = tstage(t, lo, hi);
+  if (ts == Stage::Miss) {
+    ++tests, rules += rule;
+    return;
+  }
+  if (ts == Stage::Open) {
+    open();  // t to round exactly
+    return;
+  }
+  std::uint8_t on = 0;  // inside unless rule (a) put a zero in the signs
+  Vec3f p{}, q{};
+  if (rule) hit_place(sw.s, tri, on, p, q);
+  bool nearer;
+  if (!best.hit.hit() || hi < best.t_lo) {
+    nearer = true;
+  } else if (lo > best.t_hi) {
+    nearer = false;
+  } else if (on != 0 && same_place(on, p, q, best)) {  // rule (b): the same exact t
+    ++rule;
+    nearer = prim < best.hit.prim;
+  } else {
+    open();  // enclosures that overlap: the intersector compares them
+    return;
+  }
+  ++tests, rules += rule;
+  if (!nearer) return;
+  best.hit = Hit{t, prim, 0.0f, 0.0f};
+  stage_barycentrics(sw.w, best.hit.u, best.hit.v);
+  best.t_lo = lo;
+  best.t_hi = hi;
+  best.on = on;
+  best.p = p;
+  best.q = q;
+}
+
 /// LeafIntersector::intersect(ray, prims[0..count), corners, best, counters)
 /// (corners from `corner`, below), with the double stage and the rules on exact zeros inline when the
 /// intersector allows it (LeafIntersector::staged()). A triangle is settled
@@ -279,57 +346,9 @@ template <class Corner>
     const std::array<float, 9> tri = corner_floats(ct);
     StageWeights sw;
     const Stage ws = double_weights(fr, tri, sw);
-    if (ws == Stage::Miss) {
-      ++tests;
-      continue;
-    }
-    std::uint64_t rule = 0;  // rule (a) decided a sign of this triangle
-    if (ws == Stage::Open) {
-      if (!vertex_rule(fr, ray, tri, sw) || sw.s[0] == 2 || sw.s[1] == 2 || sw.s[2] == 2) {
-        open();  // a sign for the exact stage
-        continue;
-      }
-      rule = 1;
-      if (!meets(sw.s)) {
-        ++tests, ++rules;
-        continue;
-      }
-    }
-    float t;
-    double lo, hi;
-    const Stage ts = double_t(fr, ray, tri, t, lo, hi);
-    if (ts == Stage::Miss) {
-      ++tests, rules += rule;
-      continue;
-    }
-    if (ts == Stage::Open) {
-      open();  // t to round exactly
-      continue;
-    }
-    std::uint8_t on = 0;  // inside unless rule (a) put a zero in the signs
-    Vec3f p{}, q{};
-    if (rule) hit_place(sw.s, tri, on, p, q);
-    bool nearer;
-    if (!best.hit.hit() || hi < best.t_lo) {
-      nearer = true;
-    } else if (lo > best.t_hi) {
-      nearer = false;
-    } else if (on != 0 && same_place(on, p, q, best)) {  // rule (b): the same exact t
-      ++rule;
-      nearer = prim < best.hit.prim;
-    } else {
-      open();  // enclosures that overlap: the intersector compares them
-      continue;
-    }
-    ++tests, rules += rule;
-    if (!nearer) continue;
-    best.hit = Hit{t, prim, 0.0f, 0.0f};
-    stage_barycentrics(sw.w, best.hit.u, best.hit.v);
-    best.t_lo = lo;
-    best.t_hi = hi;
-    best.on = on;
-    best.p = p;
-    best.q = q;
+    const auto tstage = [&](float& t, double& lo, double& hi) { return double_t(fr, ray, tri, t, lo, hi); };
+    staged_decide([&]() -> const ExactRayConst& { return fr; }, ray, prim, tri, ws, sw, tstage, open, best, tests,
+                  rules);
   }
   if (c) c->triangle_tests += tests, c->rule_decisions += rules;
 }

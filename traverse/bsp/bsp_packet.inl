@@ -24,6 +24,7 @@
 #include "traverse/bsp/bsp_kernel.h"
 #include "traverse/exact_double_stage.h"
 #include "traverse/simd/exact_packet_filter.h"
+#include "traverse/simd/exact_packet_stage.h"
 #include "traverse/simd/watertight_packet.h"
 
 namespace bsprt::simd {
@@ -110,21 +111,19 @@ inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count
 /// Counted runs trace single rays (BspTracer::trace_batch), so no counters here.
 template <int W>
 inline void packet_exact_leaf(const BspView& v, const CompactBspSlot& n, const WatertightPacket<W>& pre,
-                              vmask<W> filterable, const Ray* rays, NearestHit* nearest, detail::LazyExactRay* er,
-                              PacketHit<W>& hit, vmask<W> active) {
+                              vmask<W> filterable, const PacketExactRays<W>& pr, const Ray* rays,
+                              NearestHit* nearest, detail::LazyExactRay* er, PacketHit<W>& hit, vmask<W> active) {
   const std::uint32_t first = n.prim_offset(), count = n.prim_count();
+  unsigned changed = 0;  // lanes whose nearest hit's cull bound moved
   for (std::uint32_t i = first; i < first + count; ++i) {
     const BspTriangle& t = v.triangles[i];
     const unsigned need = movemask<W>(exact_packet_lanes<W>(pre, t.v[0], t.v[1], t.v[2], active, filterable));
-    for (unsigned m = need; m != 0; m &= m - 1) {
-      const int lane = std::countr_zero(m);
-      detail::exact_leaf_staged(*v.exact_leaf, rays[lane], er[lane].get(rays[lane]), v.prims + i,
-                                v.triangles + i, 1, nearest[lane], nullptr);
-    }
+    changed |= packet_exact_triangle<W>(*v.exact_leaf, pr, rays, er, nearest, need, v.prims + i, t);
   }
+  if (changed == 0) return;
   alignas(64) float tl[W];
   store<W>(tl, hit.t);
-  for (unsigned m = movemask<W>(active); m != 0; m &= m - 1) {
+  for (unsigned m = changed; m != 0; m &= m - 1) {
     const int lane = std::countr_zero(m);
     tl[lane] = cull_bound(nearest[lane]);
   }
@@ -168,6 +167,7 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
                   const Ray* rays = nullptr, NearestHit* nearest = nullptr, detail::LazyExactRay* er = nullptr) {
   WatertightPacket<W> pre;
   vmask<W> filterable{};  // exact leaves: lanes the packet prefilter may leave out
+  PacketExactRays<W> pr;   // exact leaves: the lanes' double constants, for the vector double stage
   bool have_pre = false;
   vfloat<W> tmin = r.tmin, tmax = r.tmax;
   vmask<W> active = r.live;
@@ -229,11 +229,14 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
     if (leaf) {
       if (!have_pre) {
         pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
-        if (nearest) filterable = filterable_lanes<W>(pre, r.dir);
+        if (nearest) {
+          filterable = filterable_lanes<W>(pre, r.dir);
+          packet_exact_rays<W>(rays, movemask<W>(r.live), pr);
+        }
         have_pre = true;
       }
       if (nearest)
-        packet_exact_leaf<W>(v, *n, pre, filterable, rays, nearest, er, hit, active);
+        packet_exact_leaf<W>(v, *n, pre, filterable, pr, rays, nearest, er, hit, active);
       else
         packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
     }

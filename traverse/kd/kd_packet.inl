@@ -18,6 +18,7 @@
 
 #include "traverse/kd/kd_kernel.h"
 #include "traverse/simd/exact_packet_filter.h"
+#include "traverse/simd/exact_packet_stage.h"
 #include "traverse/simd/watertight_packet.h"
 
 namespace bsprt::simd {
@@ -74,22 +75,19 @@ inline void widen(vfloat<W> t, vfloat<W>& lo, vfloat<W>& hi) {
 /// Never counted (counted runs trace single rays).
 template <int W>
 inline void packet_exact_leaf(const KdView& v, const KdNode& n, const WatertightPacket<W>& pre, vmask<W> filterable,
-                              const Ray* rays, NearestHit* nearest, detail::LazyExactRay* er, PacketHit<W>& hit,
-                              vmask<W> active) {
+                              const PacketExactRays<W>& pr, const Ray* rays, NearestHit* nearest,
+                              detail::LazyExactRay* er, PacketHit<W>& hit, vmask<W> active) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
+  unsigned changed = 0;  // lanes whose nearest hit's cull bound moved
   for (std::uint32_t i = first; i < end; ++i) {
-    const std::uint32_t p = v.prims[i];
-    const KdTriangle& t = v.triangles[p];
+    const KdTriangle& t = v.triangles[v.prims[i]];
     const unsigned need = movemask<W>(exact_packet_lanes<W>(pre, t.v[0], t.v[1], t.v[2], active, filterable));
-    for (unsigned m = need; m != 0; m &= m - 1) {
-      const int lane = std::countr_zero(m);
-      detail::exact_leaf_staged(*v.exact_leaf, rays[lane], er[lane].get(rays[lane]), v.prims + i, &t, 1,
-                                nearest[lane], nullptr);
-    }
+    changed |= packet_exact_triangle<W>(*v.exact_leaf, pr, rays, er, nearest, need, v.prims + i, t);
   }
+  if (changed == 0) return;
   alignas(64) float tl[W];
   store<W>(tl, hit.t);
-  for (unsigned m = movemask<W>(active); m != 0; m &= m - 1) {
+  for (unsigned m = changed; m != 0; m &= m - 1) {
     const int lane = std::countr_zero(m);
     tl[lane] = cull_bound(nearest[lane]);
   }
@@ -128,6 +126,7 @@ void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3],
                   detail::LazyExactRay* er = nullptr) {
   WatertightPacket<W> pre;
   vmask<W> filterable{};  // exact leaves: lanes the packet prefilter may leave out
+  PacketExactRays<W> pr;   // exact leaves: the lanes' double constants, for the vector double stage
   bool have_pre = false;
   const vfloat<W>(&o)[3] = r.o;
   vfloat<W> inv[3], tmin = r.tnear, tmax = r.tfar;
@@ -177,11 +176,14 @@ void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3],
     if (n->is_leaf()) {
       if (!have_pre) {
         pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
-        if (nearest) filterable = filterable_lanes<W>(pre, r.dir);
+        if (nearest) {
+          filterable = filterable_lanes<W>(pre, r.dir);
+          packet_exact_rays<W>(rays, movemask<W>(r.valid), pr);
+        }
         have_pre = true;
       }
       if (nearest)
-        packet_exact_leaf<W>(v, *n, pre, filterable, rays, nearest, er, hit, active);
+        packet_exact_leaf<W>(v, *n, pre, filterable, pr, rays, nearest, er, hit, active);
       else
         packet_leaf<W, kCount>(v, *n, pre, hit, active, c);
     }
