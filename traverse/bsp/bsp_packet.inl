@@ -226,8 +226,14 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
       }
       n = &v.nodes[node];
     }
-    if (leaf) {
-      if (!have_pre) {
+    const unsigned am = movemask<W>(active);
+    if (leaf && nearest && am != 0 && (am & (am - 1)) == 0) {  // exact leaves, one lane: the scalar test
+      const int lane = std::countr_zero(am);
+      detail::exact_leaf_staged(*v.exact_leaf, rays[lane], er[lane].get(rays[lane]), v.prims + n->prim_offset(),
+                                v.triangles + n->prim_offset(), n->prim_count(), nearest[lane], nullptr);
+      hit.t[lane] = cull_bound(nearest[lane]);
+    } else if (leaf) {
+      if (!have_pre) {  // the packet's constants, at its first leaf of two or more lanes
         pre = watertight_precompute_soa<W>(r.o, r.dir, r.tnear, r.tfar);
         if (nearest) {
           filterable = filterable_lanes<W>(pre, r.dir);
