@@ -14,7 +14,7 @@
 /// (a sign the filter cannot settle, a t it cannot round, an enclosure that
 /// overlaps the nearest hit's) goes to the intersector, one triangle at a
 /// time. Test: "staged exact leaf: equals the certified intersector"
-/// (tests/test_certified_intersector.cpp).
+/// (tests/test_exact_leaf.cpp).
 
 #include <algorithm>
 #include <array>
