@@ -68,8 +68,10 @@ inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray&
   }
 }
 
-/// One inner node: the near child's upper end and the far child's lower end
-/// of the ray interval, and whether near is the second child.
+/// One inner node, for the interleaved single rays (traverse_subtree inlines
+/// the same step with the kind tested once, docs/notes/2026-12-04-bsp-kd-step.md):
+/// the near child's upper end and the far child's lower end of the ray
+/// interval, and whether near is the second child.
 template <bool kCount>
 inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near_hi, float& far_lo,
                      RayCounters* c) {
@@ -104,12 +106,25 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
     while (!n->is_leaf()) {
       // The first child follows this node; fetch the second while t is computed.
       __builtin_prefetch(&v.nodes[n->second_child()]);
+      const std::uint32_t head = n->head, kind = head & 7u;
       float near_hi, far_lo;
-      const bool flip = cut_node<kCount>(n, rc, near_hi, far_lo, c);
-      const std::uint32_t first = node + n->slots(), second = n->second_child();
+      bool flip;
+      std::uint32_t first;
+      if (kind < 3) {  // kd (cut_node, with the kind tested once)
+        if constexpr (kCount) ++c->kd_node_visits;
+        detail::kd_cut<float>(n->split(), rc.o[kind], rc.inv[kind], near_hi, far_lo);
+        flip = rc.neg[kind];
+        first = node + 1;
+      } else {
+        if constexpr (kCount) ++c->bsp_node_visits;
+        flip = detail::plane_cut<float>(n, rc.o, rc.dir, rc.err, near_hi, far_lo) < 0.0f;
+        first = node + 3;
+      }
+      const std::uint32_t second = head >> CompactBspSlot::kShift;
       const std::uint32_t near = flip ? second : first, far = flip ? first : second;
-      const bool near_empty = flip ? n->second_empty() : n->first_empty();
-      const bool far_empty = flip ? n->first_empty() : n->second_empty();
+      const unsigned empties = head >> 3;  // bit 0: the first child is empty, bit 1: the second
+      const bool near_empty = ((empties >> unsigned(flip)) & 1u) != 0;
+      const bool far_empty = ((empties >> unsigned(!flip)) & 1u) != 0;
       const bool go_near = !(near_hi < tmin) && !near_empty, go_far = !(far_lo > tmax) && !far_empty;  // NaN: both
       if (!detail::step_near_far(near, far, go_near, go_far, near_hi, far_lo, node, tmin, tmax, stack, sp)) {
         leaf = false;
