@@ -378,7 +378,8 @@ TEST_CASE("staged exact leaf: equals the certified intersector, field for field 
     for (const auto& leaf : leaves) {
       std::vector<LeafTriangle> corners;
       for (const std::uint32_t q : leaf) corners.push_back({s.corner(q, 0), s.corner(q, 1), s.corner(q, 2)});
-      detail::exact_leaf_staged(c, r, leaf.data(), corners.data(), std::uint32_t(leaf.size()), staged, nullptr);
+      detail::exact_leaf_staged(c, r, detail::exact_ray_const(r), leaf.data(), corners.data(),
+                                std::uint32_t(leaf.size()), staged, nullptr);
     }
     require_same(staged.hit, want);
   }

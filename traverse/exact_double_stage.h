@@ -244,7 +244,7 @@ inline std::array<float, 9> corner_floats(const LeafTriangle& t) { return std::b
 
 /// The staged test's decision for one triangle whose weights the double
 /// stage has computed (`ws`, `sw`, from double_weights), in
-/// exact_leaf_staged_by's order: rule (a) for open signs, then t from
+/// exact_leaf_staged's order: rule (a) for open signs, then t from
 /// `tstage(t, lo, hi)` (double_t's result, computed on demand or given by a
 /// packet kernel, bit for bit the same), then the nearest hit with rule (b).
 /// Anything the double stage and the rules leave open goes to `open()`
@@ -309,8 +309,8 @@ template <class Fr, class TStage, class Open>
   best.q = q;
 }
 
-/// LeafIntersector::intersect(ray, prims[0..count), corners, best, counters)
-/// (corners from `corner`, below), with the double stage and the rules on exact zeros inline when the
+/// LeafIntersector::intersect(ray, prims[0..count), corners, best, counters),
+/// with the double stage and the rules on exact zeros inline when the
 /// intersector allows it (LeafIntersector::staged()). A triangle is settled
 /// here when the double stage, with rule (a) for what it leaves open, decides
 /// its weights and its t, and its t enclosure is clear of the nearest hit's
@@ -322,28 +322,22 @@ template <class Fr, class TStage, class Open>
 /// same comparisons, so the answer, the enclosure and the counters are its
 /// own. `ray` must be valid. `fr` = exact_ray_const(ray), made once per ray by
 /// the caller.
-///
-/// `corner(i)` gives the corners of prims[i] (a const LeafTriangle&): a
-/// traversal that keeps corners by triangle number reads them in place.
-template <class Corner>
-[[gnu::always_inline]] inline void exact_leaf_staged_by(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
-                                 const std::uint32_t* prims, std::uint32_t count, Corner&& corner, NearestHit& best,
-                                 RayCounters* c) {
+[[gnu::always_inline]] inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
+                                                     const std::uint32_t* prims, const LeafTriangle* corners,
+                                                     std::uint32_t count, NearestHit& best, RayCounters* c) {
   if (!x.staged() || exact_filter_off_for_testing != 0) {
-    for (std::uint32_t i = 0; i < count; ++i)
-      x.intersect(ray, std::span<const std::uint32_t>(prims + i, 1), &corner(i), best, c);
+    x.intersect(ray, std::span<const std::uint32_t>(prims, count), corners, best, c);
     return;
   }
   std::uint64_t tests = 0, rules = 0;
   for (std::uint32_t i = 0; i < count; ++i) {
     const std::uint32_t prim = prims[i];
-    const LeafTriangle& ct = corner(i);
-    const auto open = [&] { x.intersect(ray, std::span<const std::uint32_t>(prims + i, 1), &ct, best, c); };
+    const auto open = [&] { x.intersect(ray, std::span<const std::uint32_t>(prims + i, 1), corners + i, best, c); };
     if (best.hit.hit() && prim == best.hit.prim) {  // met again in another leaf: not nearer than itself
       ++tests;
       continue;
     }
-    const std::array<float, 9> tri = corner_floats(ct);
+    const std::array<float, 9> tri = corner_floats(corners[i]);
     StageWeights sw;
     const Stage ws = double_weights(fr, tri, sw);
     const auto tstage = [&](float& t, double& lo, double& hi) { return double_t(fr, ray, tri, t, lo, hi); };
@@ -351,18 +345,6 @@ template <class Corner>
                   rules);
   }
   if (c) c->triangle_tests += tests, c->rule_decisions += rules;
-}
-
-/// As exact_leaf_staged_by, with the corners of prims[i] at corners[i].
-[[gnu::always_inline]] inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
-                              const std::uint32_t* prims, const LeafTriangle* corners, std::uint32_t count,
-                              NearestHit& best, RayCounters* c) {
-  if (!x.staged() || exact_filter_off_for_testing != 0) {
-    x.intersect(ray, std::span<const std::uint32_t>(prims, count), corners, best, c);
-    return;
-  }
-  exact_leaf_staged_by(x, ray, fr, prims, count, [corners](std::uint32_t i) -> const LeafTriangle& { return corners[i]; },
-                       best, c);
 }
 
 /// The ray's double constants, made on first use (exact_ray_const costs two
@@ -376,12 +358,6 @@ struct LazyExactRay {
     return fr;
   }
 };
-
-/// As above, making the ray's constants for this call.
-inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const std::uint32_t* prims,
-                              const LeafTriangle* corners, std::uint32_t count, NearestHit& best, RayCounters* c) {
-  exact_leaf_staged(x, ray, exact_ray_const(ray), prims, corners, count, best, c);
-}
 
 }  // namespace BSPRT_ISA_NAMESPACE
 }  // namespace bsprt::detail

@@ -31,8 +31,8 @@ inline constexpr float kKdTHi = 1.0f + 0x1p-21f;
 /// would put every crossing of that axis at ±inf and cull the cells the ray
 /// reaches at a finite t. A NaN crossing culls nothing (both children, the
 /// whole interval), as in the BSP's setup (bsp_kernel.h, ray_setup_core).
-/// Regression test "exact packets: bsp and kd equal ... the exact reference"
-/// (tests/test_bsp_traverse.cpp, the subnormal-shear rays).
+/// Regression test "kd and exact packets: a subnormal direction component
+/// loses no hit" (tests/test_bsp_traverse.cpp).
 inline float kd_reciprocal(float d) {
   return (d == 0.0f || std::fabs(d) >= 0x1p-126f) ? 1.0f / d : std::numeric_limits<float>::quiet_NaN();
 }

@@ -32,17 +32,6 @@
 namespace bsprt::simd {
 inline namespace BSPRT_ISA_NAMESPACE {
 
-/// GCC vectors of W doubles and W int64 lane masks.
-template <int W>
-struct VecDoubles {
-  typedef double D __attribute__((vector_size(8 * W)));
-  typedef std::int64_t M __attribute__((vector_size(8 * W)));
-};
-template <int W>
-using vdouble = typename VecDoubles<W>::D;
-template <int W>
-using vmask64 = typename VecDoubles<W>::M;
-
 namespace exact_stage_detail {
 template <int W>
 inline vdouble<W> dabs(vdouble<W> x) {  // std::abs: the sign bit cleared (NaN and -0 included)
@@ -64,11 +53,12 @@ inline vmask64<W> opposite(vmask64<W> a, vmask64<W> b) {  // detail::opposite_si
 }  // namespace exact_stage_detail
 
 /// The lanes' ExactRayConst in SoA form, for a packet whose live lanes share
-/// (kx, ky, kz). Lanes that are not live hold zeros and 1 as d[kz] (never read).
+/// (kx, ky, kz), made by packet_exact_rays. Lanes that are not live hold zeros
+/// and 1 as d[kz] (never read).
 template <int W>
 struct PacketExactRays {
-  alignas(64) double ox[W]{}, oy[W]{}, oz[W]{}, sx[W]{}, sy[W]{}, asx[W]{}, asy[W]{};
-  alignas(64) double d[3][W]{}, o[3][W]{}, tnear[W]{}, tfar[W]{};
+  alignas(64) double ox[W], oy[W], oz[W], sx[W], sy[W], asx[W], asy[W];
+  alignas(64) double d[3][W], o[3][W], tnear[W], tfar[W];
   int kx = 0, ky = 1, kz = 2;
   bool uniform = false;  ///< the live lanes share the axes: the vector stage applies
 };
@@ -78,6 +68,7 @@ struct PacketExactRays {
 /// shear's two divisions four lanes at a time (the same IEEE divisions).
 template <int W>
 inline void packet_exact_rays(const Ray* rays, unsigned lanes, PacketExactRays<W>& p) {
+  p = PacketExactRays<W>{};  // zeros (made here, not per packet: float packets never use it)
   p.uniform = true;
   bool first = true;
   for (unsigned m = lanes; m != 0; m &= m - 1) {

@@ -76,6 +76,18 @@ using vint = typename VecTypes<W>::I;
 template <int W>
 using vmask = vint<W>;
 
+/// GCC vectors of W doubles and the W int64 lane masks their comparisons yield
+/// (the exact leaves' double stage, exact_packet_stage.h).
+template <int W>
+struct VecDoubles {
+  typedef double D __attribute__((vector_size(8 * W)));
+  typedef std::int64_t M __attribute__((vector_size(8 * W)));
+};
+template <int W>
+using vdouble = typename VecDoubles<W>::D;
+template <int W>
+using vmask64 = typename VecDoubles<W>::M;
+
 /// All lanes equal to x.
 template <int W>
 inline vfloat<W> splat(float x) {
