@@ -168,7 +168,7 @@ void register_render(CLI::App& app) {
   cmd->add_option("--heat-metric", args->heat_metric, "heat: time | nodes | tests")->capture_default_str();
   cmd->add_option("--heat-compare", args->heat_compare, "heat: draw the difference to this accelerator's map");
   cmd->add_option("--heat-max", args->heat_max, "heat: top of the colour scale (0 = the image's maximum)");
-  add_trace_options(*cmd, args->trace, "embree");
+  add_trace_options(*cmd, args->trace, "bsp");
   cmd->callback([args] { run(*args); });
 }
 

@@ -227,7 +227,7 @@ void register_trace(CLI::App& app) {
   cmd->add_option("SCENE", args->scene, "mesh file (obj, ply, off, stl) or 'default'")->required();
   cmd->add_option("RAYS", args->rays, ".rays file (see `bsprt gen-rays`)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->hits, ".hits file to write")->required();
-  add_trace_options(*cmd, args->trace, "embree");
+  add_trace_options(*cmd, args->trace, "bsp");
   cmd->add_flag("--all-hits", args->all_hits,
                 "write every crossing of every ray, exactly (simulation of simplicity: a ray through a shared edge "
                 "or vertex crosses one triangle of each sheet), as CSV ray,prim,t,side, instead of a .hits file");

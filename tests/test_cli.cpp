@@ -416,3 +416,32 @@ TEST_CASE("cli: exact leaves are the default; the old names say so; --stats coun
   CHECK(c.agrees());
   CHECK(c.tie == 0);
 }
+
+// Regression: trace and render defaulted to --accel embree while the README
+// and issue #23 say the exact BSP is the default. Without --accel they now
+// trace the exact BSP: the hits equal the exact reference's, ties included,
+// where Embree's differ on these vertex rays.
+TEST_CASE("cli: trace and render without --accel use the exact BSP", "[cli][regression]") {
+  const std::string scene = scene_path("suzanne.obj"), rays = temp_path("cli_no_accel.rays");
+  REQUIRE(bsprt_cli("gen-rays " + scene + " --kind vertex -n 3000 --seed 11 -o " + rays).status == 0);
+  const std::string got = temp_path("cli_no_accel.hits"), ref = temp_path("cli_no_accel_ref.hits");
+  const Run t = bsprt_cli("trace " + scene + " " + rays + " -o " + got);
+  INFO(t.output);
+  REQUIRE(t.status == 0);
+  CHECK(t.output.find("accel bsp:") != std::string::npos);
+  REQUIRE(bsprt_cli("trace " + scene + " " + rays + " -o " + ref + " --accel exact").status == 0);
+  const HitComparison c = compare_hits(read_hits(ref), read_hits(got));
+  CHECK(c.agrees());
+  CHECK(c.tie == 0);
+  CHECK(c.max_t_ulps == 0);
+  // The options only the BSP uses are accepted without --accel.
+  CHECK(bsprt_cli("trace " + scene + " " + rays + " -o " + got + " --single-rays interleaved").status == 0);
+  const Run r = bsprt_cli("render " + scene + " -o " + temp_path("cli_no_accel.png") + " --size 16 12");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("with bsp") != std::string::npos);
+  for (const char* sub : {"trace", "render"}) {
+    const Run h = bsprt_cli(std::string(sub) + " --help");
+    CHECK(h.output.find("--accel TEXT=bsp ") != std::string::npos);
+  }
+}
