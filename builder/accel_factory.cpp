@@ -86,9 +86,11 @@ void add_top(BspTracer& t, BspTop top, std::uint32_t slots) {
 
 /// bsp, bsp-top or bsp-bvh8: the BSP with exact leaves, under `top` of subtrees of at most `slots` slots.
 std::unique_ptr<Accelerator> make_exact_bsp(const TriangleSoup& soup, FlatBspTree flat, BspTop top,
-                                            std::uint32_t slots, BspSingleRays single_rays) {
+                                            std::uint32_t slots, BspSingleRays single_rays,
+                                            BspPackets packets = BspPackets::Auto) {
   auto t = std::make_unique<ExactLeafTracer<BspTracer>>(soup, std::move(flat), soup, BspEpsilon::Certified);
   t->tracer().set_single_rays(single_rays);
+  t->tracer().set_packets(packets);
   add_top(t->tracer(), top, slots);
   return t;
 }
@@ -121,6 +123,7 @@ std::unique_ptr<Accelerator> make_bsp(const TriangleSoup& soup, const AccelOptio
                                       BspEpsilon eps) {
   auto bsp = std::make_unique<BspTracer>(load_or_build_bsp(soup, options), soup, eps);
   bsp->set_single_rays(options.single_rays);
+  bsp->set_packets(options.bsp_packets);
   return bsp;
 }
 
@@ -160,7 +163,7 @@ constexpr AccelInfo kTable[] = {
     {"bsp", "exact BSP, certified traversal, exact-decision leaf test (the default)", A::Bsp, true, true, false,
      false, true, false,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return make_exact_bsp(s, load_or_build_bsp(s, o), BspTop::None, 0, o.single_rays);
+       return make_exact_bsp(s, load_or_build_bsp(s, o), BspTop::None, 0, o.single_rays, o.bsp_packets);
      }},
     {"bsp-float", "exact BSP, certified float traversal, float watertight leaf test", A::Bsp, false, true, false,
      false, true, false,

@@ -39,6 +39,10 @@ struct AccelOptions {
   std::uint32_t top_slots = 0;
   /// bsp, bsp-zero-eps: how batches of single rays run (traverse/bsp_traverse.h).
   BspSingleRays single_rays = BspSingleRays::Auto;
+  /// bsp, bsp-float, bsp-zero-eps: whether packets of incoherent rays run as
+  /// single rays (Auto) or every packet through the packet kernel (Always,
+  /// for tests of the kernel); traverse/bsp_traverse.h.
+  BspPackets bsp_packets = BspPackets::Auto;
 
   bool has_tree() const { return tree_file || !tree_path.empty(); }
 };

@@ -104,6 +104,7 @@ std::unique_ptr<bsprt::Accelerator> make(const std::string& accel, const bsprt::
   bsprt::AccelOptions o;
   o.threads = 1;
   o.top_slots = top_slots;
+  o.bsp_packets = bsprt::BspPackets::Always;  // the packet kernel on every packet, incoherent ones too
   return bsprt::make_tracer(accel, s, o);
 }
 

@@ -347,7 +347,8 @@ TEST_CASE("BSP packets equal single rays exactly", "[bsp]") {
   const BspScene s = build_bsp_scene(load_mesh(scene_path("suzanne.obj")));
   const BspScene q = build_bsp_scene(make_default_scene());
   for (const BspScene* sc : {&s, &q}) {
-    const BspTracer tracer(sc->flat, sc->soup);
+    BspTracer tracer(sc->flat, sc->soup);
+    tracer.set_packets(BspPackets::Always);  // the packet kernel on incoherent packets too
     std::vector<Ray> rays = all_ray_sets(sc->soup, 1000, 11);
     // The same rays again, every third from a point inside the scene's box with
     // tnear < 0 (its interval starts behind the origin, negative crossings): packets
@@ -388,6 +389,72 @@ TEST_CASE("BSP packets equal single rays exactly", "[bsp]") {
   }
 }
 
+TEST_CASE("packet_looks_coherent: a camera tile is, random directions are not, invalid lanes do not count",
+          "[bsp]") {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  std::vector<Ray> tile;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) tile.push_back({{0, 0, 0}, 0, {-0.05f + 0.01f * x, 1, 0.03f - 0.01f * y}});
+  CHECK(packet_looks_coherent(tile));
+  // Straddling an axis (mixed direction signs) is still one narrow cone.
+  CHECK(packet_looks_coherent(std::vector<Ray>{{{0, 0, 0}, 0, {-0.01f, 1, 0}}, {{0, 0, 0}, 0, {0.01f, 1, 0}}}));
+  std::vector<Ray> wide = tile;
+  wide[7].dir = {1, 1, 0};  // 45 degrees from the others
+  CHECK_FALSE(packet_looks_coherent(wide));
+  wide[7].dir = {0.05f, -1, 0};  // opposite
+  CHECK_FALSE(packet_looks_coherent(wide));
+  std::vector<Ray> invalid = tile;
+  invalid[0].dir = {0, 0, 0}, invalid[3].dir = {nan, 1, 0}, invalid[5].dir = {inf, 1, 0};
+  CHECK(packet_looks_coherent(invalid));
+  CHECK(packet_looks_coherent(std::span<const Ray>(tile.data(), 1)));
+  CHECK(packet_looks_coherent(std::span<const Ray>()));
+  // Huge and tiny direction lengths: no overflow to a false "not coherent".
+  std::vector<Ray> scaled = tile;
+  for (Ray& r : scaled) r.dir = r.dir * 0x1p60f;
+  CHECK(packet_looks_coherent(scaled));
+}
+
+// Packets of incoherent rays (random, vertex, path-traced) ran 25-35 % slower
+// through the BSP packet kernel than as single rays (docs/perf/bench.csv at
+// 93d582f); they now run as single rays. Every way gives the same hits.
+TEST_CASE("bsp packets: batches mixing coherent and incoherent packets equal single rays and the kernel",
+          "[bsp][exact]") {
+  const TriangleSoup soup = load_mesh(scene_path("suzanne.obj"));
+  const std::vector<Ray> camera = make_rays(RaySetKind::Primary, soup, 700, 3);
+  const std::vector<Ray> random = make_rays(RaySetKind::Random, soup, 700, 4);
+  // Runs of coherent and incoherent packets of every length, batch sizes not a multiple of 16.
+  std::vector<Ray> rays;
+  for (std::size_t i = 0, c = 0, r = 0, k = 1; c + 64 < camera.size() && r + 64 < random.size(); ++i, ++k) {
+    const std::size_t take = 5 * k % 61 + 3;
+    const std::vector<Ray>& from = i % 2 ? random : camera;
+    std::size_t& at = i % 2 ? r : c;
+    rays.insert(rays.end(), from.begin() + long(at), from.begin() + long(at + take));
+    at += take;
+  }
+  for (const char* accel : {"bsp", "bsp-float"}) {
+    AccelOptions always;
+    always.bsp_packets = BspPackets::Always;
+    const std::unique_ptr<Accelerator> a = make_tracer(accel, soup), k = make_tracer(accel, soup, always);
+    std::vector<Hit> single(rays.size());
+    a->trace_batch(rays, single, 1);
+    for (int w : {4, 8, 16}) {
+      if (int(detected_isa()) < int(isa_for_width(w))) continue;
+      for (std::size_t batch : {rays.size(), std::size_t(37), std::size_t(5)}) {
+        std::vector<Hit> got(rays.size()), kernel(rays.size());
+        for (std::size_t b = 0; b < rays.size(); b += batch) {
+          const std::size_t m = std::min(batch, rays.size() - b);
+          a->trace_batch(std::span<const Ray>(rays.data() + b, m), std::span<Hit>(got.data() + b, m), w);
+          k->trace_batch(std::span<const Ray>(rays.data() + b, m), std::span<Hit>(kernel.data() + b, m), w);
+        }
+        INFO(accel << ", packets of " << w << ", batches of " << batch);
+        CHECK(std::memcmp(got.data(), single.data(), rays.size() * sizeof(Hit)) == 0);
+        CHECK(std::memcmp(kernel.data(), single.data(), rays.size() * sizeof(Hit)) == 0);
+      }
+    }
+    CHECK(std::count_if(single.begin(), single.end(), [](const Hit& h) { return h.hit(); }) > 100);
+  }
+}
+
 TEST_CASE("exact packets: bsp and kd equal their single rays and the exact reference at every width",
           "[bsp][kd][exact]") {
   // Exact leaves in packets test each triangle against all lanes in the
@@ -412,7 +479,9 @@ TEST_CASE("exact packets: bsp and kd equal their single rays and the exact refer
     std::size_t hits = 0;
     for (const Hit& h : ref) hits += h.hit();
     for (const char* accel : {"bsp", "kd"}) {
-      const std::unique_ptr<Accelerator> t = make_tracer(accel, soup);
+      AccelOptions always;
+      always.bsp_packets = BspPackets::Always;  // the packet kernel on incoherent packets too
+      const std::unique_ptr<Accelerator> t = make_tracer(accel, soup, always);
       std::vector<Hit> single(rays.size());
       t->trace_batch(rays, single, 1);
       std::size_t wrong = 0;
@@ -635,7 +704,8 @@ TEST_CASE("BSP: a direction scaled out of range by a power of two is traced at n
   const BspScene s = build_bsp_scene(soup);
   std::vector<Ray> base = all_ray_sets(s.soup, 150, 17);
   for (std::size_t i = 0; i < base.size(); i += 4) base[i].tfar = 2.5f;  // bounded segments too
-  const BspTracer plain(s.flat, s.soup);
+  BspTracer plain(s.flat, s.soup);
+  plain.set_packets(BspPackets::Always);  // the packet kernel on incoherent packets too
   RayCounters cb;
   std::vector<Hit> hb(base.size());
   plain.trace_batch(base, hb, 1, &cb);

@@ -4,6 +4,7 @@
 #include "traverse/bsp/bsp_traverse.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstddef>
@@ -513,6 +514,30 @@ bool rays_look_coherent(std::span<const Ray> rays) {
   });
 }
 
+bool packet_looks_coherent(std::span<const Ray> rays) {
+  // In double: squared lengths and their products of any finite float
+  // direction neither overflow nor underflow there.
+  const auto d = [](const Vec3f& v) { return std::array<double, 3>{v.x, v.y, v.z}; };
+  const auto dotd = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  };
+  bool first = true;
+  std::array<double, 3> a{};
+  double aa = 0.0;
+  for (const Ray& r : rays) {
+    const std::array<double, 3> b = d(r.dir);
+    const double bb = dotd(b, b);
+    if (!(bb > 0.0) || !std::isfinite(bb)) continue;  // an invalid lane: it traces nothing
+    if (first) {
+      a = b, aa = bb, first = false;
+      continue;
+    }
+    const double ab = dotd(a, b);  // cos^2 > 0.98: within about 8 degrees
+    if (!(ab > 0.0 && ab * ab > 0.98 * aa * bb)) return false;
+  }
+  return true;
+}
+
 bool rays_unbounded(std::span<const Ray> rays) {
   return !rays.empty() && half_of_samples(rays.size(), [&](std::size_t i) {
     return rays[i].tfar == std::numeric_limits<float>::infinity();
@@ -546,29 +571,51 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
   // Box tops trace single rays, and so do exact leaves when counted (the
   // packet kernels count no exact decisions; the counts are the same).
-  if (need == Isa::Scalar || tree_.bounds.empty() || (exact_leaf_ && counters) || has_top_ || wide_) {
+  const auto singles = [&](std::span<const Ray> r, std::span<Hit> h) {
     const bool interleave = !counters && !has_top_ && !wide_ && !tree_.bounds.empty() &&
                             (single_rays_ == BspSingleRays::Interleaved ||
-                             (single_rays_ == BspSingleRays::Auto && !rays_look_coherent(rays) &&
-                              rays_unbounded(rays)));
+                             (single_rays_ == BspSingleRays::Auto && !rays_look_coherent(r) && rays_unbounded(r)));
     if (interleave) {
-      trace_interleaved(v, rays.data(), rays.size(), hits.data());
+      trace_interleaved(v, r.data(), r.size(), h.data());
       return;
     }
-    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = trace(rays[i], counters);
+    for (std::size_t i = 0; i < r.size(); ++i) h[i] = trace(r[i], counters);
+  };
+  if (need == Isa::Scalar || tree_.bounds.empty() || (exact_leaf_ && counters) || has_top_ || wide_) {
+    singles(rays, hits);
     return;
   }
-  switch (need) {
-    case Isa::Sse42:
-      detail::bsp_trace_packets_sse42(v, rays.data(), rays.size(), hits.data(), counters);
-      break;
-    case Isa::Avx2:
-      detail::bsp_trace_packets_avx2(v, rays.data(), rays.size(), hits.data(), counters);
-      break;
-    case Isa::Avx512:
-      detail::bsp_trace_packets_avx512(v, rays.data(), rays.size(), hits.data(), counters);
-      break;
-    case Isa::Scalar: break;
+  const auto packets = [&](std::span<const Ray> r, std::span<Hit> h) {
+    switch (need) {
+      case Isa::Sse42:
+        detail::bsp_trace_packets_sse42(v, r.data(), r.size(), h.data(), counters);
+        break;
+      case Isa::Avx2:
+        detail::bsp_trace_packets_avx2(v, r.data(), r.size(), h.data(), counters);
+        break;
+      case Isa::Avx512:
+        detail::bsp_trace_packets_avx512(v, r.data(), r.size(), h.data(), counters);
+        break;
+      case Isa::Scalar: break;
+    }
+  };
+  if (packets_ == BspPackets::Always) {
+    packets(rays, hits);
+    return;
+  }
+  // Runs of coherent packets go to the packet kernel, runs of incoherent ones
+  // to the single rays, each run whole (the interleaved kernel keeps eight
+  // rays in flight across packet boundaries).
+  const std::size_t n = rays.size(), w = std::size_t(packet_width);
+  const auto coherent = [&](std::size_t at) { return packet_looks_coherent(rays.subspan(at, std::min(w, n - at))); };
+  for (std::size_t at = 0; at < n;) {
+    const bool c = coherent(at);
+    std::size_t end = at + w;
+    while (end < n && coherent(end) == c) end += w;
+    end = std::min(end, n);
+    if (c) packets(rays.subspan(at, end - at), hits.subspan(at, end - at));
+    else singles(rays.subspan(at, end - at), hits.subspan(at, end - at));
+    at = end;
   }
 }
 

@@ -59,6 +59,26 @@ enum class BspSingleRays {
 /// about 8 degrees of each other. Picks the single-ray kernel only.
 bool rays_look_coherent(std::span<const Ray> rays);
 
+/// Whether the rays of one packet are coherent enough for the packet kernel:
+/// every ray with a finite, nonzero direction is within about 8 degrees of the
+/// first such ray (cos^2 > 0.98, the test rays_look_coherent makes between
+/// neighbours). Picks the kernel only; hits are the same either way.
+bool packet_looks_coherent(std::span<const Ray> rays);
+
+/// How BspTracer::trace_batch runs a batch asked for in packets. Each lane of
+/// a packet makes the single ray's steps, so hits are the same bit for bit;
+/// only speed differs.
+enum class BspPackets {
+  /// A packet whose rays are not coherent (packet_looks_coherent) runs as
+  /// single rays, as set_single_rays says: its lanes would part at most plane
+  /// nodes, and the packet kernel then runs slower than single rays (random,
+  /// vertex, edge and path-traced rays, docs/certified-epsilons.md §6). The
+  /// kd-tree's packets do the same for rays of mixed direction signs.
+  Auto,
+  /// Every packet through the packet kernel (tests of the kernel itself).
+  Always,
+};
+
 /// Whether at least half of up to 16 evenly spaced rays of a batch have
 /// tfar = +inf (an empty batch: false). Picks the single-ray kernel only.
 bool rays_unbounded(std::span<const Ray> rays);
@@ -98,7 +118,8 @@ class BspTracer final : public Accelerator {
   /// rays bit for bit. With a box top packets run as single rays; with
   /// exact leaves each active lane runs the exact test at a leaf. With
   /// counters or a box top single rays run sequentially, and so do packets
-  /// with exact leaves when counted.
+  /// with exact leaves when counted. Packets whose rays are not coherent run
+  /// as single rays unless set_packets(BspPackets::Always).
   void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width = 1,
                    RayCounters* counters = nullptr) const override;
   /// The tree cut into subtrees of at most `max_slots` slots, with their
@@ -140,6 +161,9 @@ class BspTracer final : public Accelerator {
   /// How trace_batch runs single rays (default Auto); not while tracing.
   void set_single_rays(BspSingleRays how) { single_rays_ = how; }
   BspSingleRays single_rays() const { return single_rays_; }
+  /// How trace_batch runs packets (default Auto); not while tracing.
+  void set_packets(BspPackets how) { packets_ = how; }
+  BspPackets packets() const { return packets_; }
   const BoxTop& box_top() const { return top_; }
   /// Nodes, leaf lists, the copied triangles and the box top.
   std::size_t memory_bytes() const override;
@@ -159,6 +183,7 @@ class BspTracer final : public Accelerator {
   std::unique_ptr<Bvh8Tracer> wide_;  ///< the BVH8 top, or null
   bool wide_safe_scene_ = false;      ///< root cell within the BVH8 kernel's range (2^64)
   BspSingleRays single_rays_ = BspSingleRays::Auto;
+  BspPackets packets_ = BspPackets::Auto;
 };
 
 }  // namespace bsprt
