@@ -43,12 +43,12 @@ inline void clip_root(const Box3f& b, const float o[3], const float inv[3], cons
 /// exact order and the answer; hit then holds its prim and, as t, the cull
 /// bound (cull_bound).
 template <bool kCount>
-inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, const WatertightRay& wr, Hit& hit,
-                           NearestHit& nearest, RayCounters* c) {
+inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, const WatertightRay& wr, bool filter,
+                           Hit& hit, NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if (v.exact_leaf) {
     if constexpr (kCount) ++c->leaf_visits;
-    detail::kd_exact_leaf(v, first, end, ray, wr, detail::filterable(wr, ray), nearest, kCount ? c : nullptr);
+    detail::kd_exact_leaf(v, first, end, ray, wr, filter, nearest, kCount ? c : nullptr);
     hit.prim = nearest.hit.prim;
     hit.t = cull_bound(nearest);
     return;
@@ -71,8 +71,10 @@ inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, con
 /// branches let the CPU fetch the next node before t is known (a branch-free
 /// step measured 30% slower). A popped cell is skipped when its entry is past
 /// the nearest hit. kd_packet.inl repeats these steps lane by lane, bit for bit.
+/// `filter`: exact leaves may use their float prefilter (detail::filterable,
+/// a property of the ray, made once per ray).
 template <bool kCount, bool kNonNegative>
-Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, const float o[3],
+Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, bool filter, const float o[3],
                const float inv[3], const bool neg[3], float tmin, float tmax, RayCounters* c) {
   Hit hit;
   NearestHit nearest;
@@ -102,7 +104,7 @@ Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, const f
       if (!detail::step_near_far(near, far, go_near, go_far, th, tl, node, tmin, tmax, stack, sp)) break;
       n = &v.nodes[node];
     }
-    if (n->is_leaf()) intersect_leaf<kCount>(v, *n, ray, wr, hit, nearest, c);
+    if (n->is_leaf()) intersect_leaf<kCount>(v, *n, ray, wr, filter, hit, nearest, c);
     if (!detail::pop_before(stack, sp, hit.t, node, tmin, tmax)) return v.exact_leaf ? nearest.hit : hit;
   }
 }
@@ -120,9 +122,10 @@ Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
   float tmin = ray.tnear, tmax = ray.tfar;
   clip_root(v.bounds, o, inv, neg, tmin, tmax);
   if (!(tmin <= tmax)) return hit;
+  const bool filter = v.exact_leaf && detail::filterable(wr, ray);
   const auto walk = [&]() {
-    return tmin >= 0.0f ? trace_from<kCount, true>(v, ray, wr, o, inv, neg, tmin, tmax, c)
-                        : trace_from<kCount, false>(v, ray, wr, o, inv, neg, tmin, tmax, c);
+    return tmin >= 0.0f ? trace_from<kCount, true>(v, ray, wr, filter, o, inv, neg, tmin, tmax, c)
+                        : trace_from<kCount, false>(v, ray, wr, filter, o, inv, neg, tmin, tmax, c);
   };
   if constexpr (kCount) {
     const std::uint64_t before = c->exact_decisions;  // set by an exact leaf test
