@@ -59,9 +59,11 @@ inline unsigned exact_lanes(const WatertightRay& r, const float* rows, std::uint
   const auto lane = [&](int c, int k) { return simd::load<4>(rows + (3 * c + k) * count); };
   const V4 sx = simd::splat<4>(r.sx), sy = simd::splat<4>(r.sy);
   const V4 asx = simd::abs<4>(sx), asy = simd::abs<4>(sy);
+  // The origin's sheared axes once (Vec3's operator[] with a run-time axis is a select chain).
+  const float ox = r.org[r.kx], oy = r.org[r.ky], oz = r.org[r.kz];
   V4 x[3], y[3], mx = simd::splat<4>(0.0f), my = simd::splat<4>(0.0f);
   for (int c = 0; c < 3; ++c) {
-    const V4 az = lane(c, r.kz) - r.org[r.kz], ax = lane(c, r.kx) - r.org[r.kx], ay = lane(c, r.ky) - r.org[r.ky];
+    const V4 az = lane(c, r.kz) - oz, ax = lane(c, r.kx) - ox, ay = lane(c, r.ky) - oy;
     x[c] = ax - no_fma(sx * az);
     y[c] = ay - no_fma(sy * az);
     const V4 aaz = simd::abs<4>(az);
