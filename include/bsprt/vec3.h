@@ -21,8 +21,16 @@ struct Vec3 {
   template <typename U>
   constexpr explicit Vec3(const Vec3<U>& o) : x(T(o.x)), y(T(o.y)), z(T(o.z)) {}
 
-  constexpr T operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
-  constexpr T& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+  /// Component i (0, 1 or 2). Through a table of member pointers: one indexed
+  /// load, no compare chain, for the run-time axes of the traversals
+  /// (shear axes, split axes), which are unpredictable on incoherent rays.
+  constexpr T operator[](int i) const { return this->*kMembers[i]; }
+  constexpr T& operator[](int i) { return this->*kMembers[i]; }
+
+ private:
+  static constexpr T Vec3::*kMembers[3] = {&Vec3::x, &Vec3::y, &Vec3::z};
+
+ public:
 
   constexpr Vec3 operator+(const Vec3& o) const { return {x + o.x, y + o.y, z + o.z}; }
   constexpr Vec3 operator-(const Vec3& o) const { return {x - o.x, y - o.y, z - o.z}; }
