@@ -65,7 +65,7 @@ watertight float triangle test; **bsp-top** the same tree under a 4-wide box top
 subtrees of ≤ 1024 slots (single rays only, exact leaves; docs/certified-epsilons.md §10);
 **bsp-zero-eps** the same tree with all epsilons 0 and float leaves;
 **bvh8** / **bvh8-float** a plain 8-wide BVH traced by an Embree-style single-ray kernel, exact / float leaves
-(docs/bvh8.md; no BSP below it yet);
+(docs/bvh8.md; the BSP under such a top is \`bsp-bvh8\`, not in these tables);
 **embree** Embree 3 robust mode; **embree-fast** Embree 3 default mode; **brute-certified** every
 triangle, decided exactly. Error is measured ray by ray against \`ExactTracer\` (CGAL exact
 ray/triangle intersection on the same float rays), in the vocabulary of \`bsprt compare\`: *lost* (reference
@@ -73,7 +73,9 @@ hits, mode misses), *farther* (a leak: the mode reports a surface behind the exa
 *extra*, *nearer*, and |t − t_exact| in ulps. Speed: Mrays/s of all threads, best of 2 passes over the
 same rays, timing the traversal only (rays checked and output touched before; Embree through this
 harness runs within 2 % of a plain \`rtcIntersect1\` loop, docs/notes/2026-12-01-timing-harness.md);
-primary rays in 8×8 tiles. The tables are the summaries \`bsprt bench\` writes
+primary rays in 8×8 tiles. Packets: a BSP packet whose rays spread over more than about 8° runs as
+single rays (docs/certified-epsilons.md §5), and so does a kd packet of mixed direction signs; Embree's
+packets are \`rtcIntersect4/8/16\` whatever the rays. The tables are the summaries \`bsprt bench\` writes
 (\`docs/perf/PREFIX-speed-RAYS.md\`, \`PREFIX-error-RAYS.md\`).
 
 ## Key finding: rays aimed at the bunny's vertices (${vcount} rays)
