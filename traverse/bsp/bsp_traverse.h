@@ -72,7 +72,7 @@ enum class BspPackets {
   /// A packet whose rays are not coherent (packet_looks_coherent) runs as
   /// single rays, as set_single_rays says: its lanes would part at most plane
   /// nodes, and the packet kernel then runs slower than single rays (random,
-  /// vertex, edge and path-traced rays, docs/certified-epsilons.md §6). The
+  /// vertex, edge and path-traced rays, docs/certified-epsilons.md §5). The
   /// kd-tree's packets do the same for rays of mixed direction signs.
   Auto,
   /// Every packet through the packet kernel (tests of the kernel itself).
