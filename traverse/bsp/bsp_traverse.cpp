@@ -4,7 +4,6 @@
 #include "traverse/bsp/bsp_traverse.h"
 
 #include <algorithm>
-#include <array>
 #include <bit>
 #include <cmath>
 #include <cstddef>
@@ -505,35 +504,30 @@ bool half_of_samples(std::size_t n, Test test) {
 }
 }  // namespace
 
+namespace {
+/// Whether two directions are within about 8 degrees (cos^2 > 0.98). In
+/// double: squared lengths and their products of any finite float direction
+/// neither overflow nor underflow there. NaN or a zero direction: not close.
+bool directions_close(const Vec3f& a, const Vec3f& b) {
+  const Vec3d da(a), db(b);
+  const double ab = dot(da, db);
+  return ab > 0.0 && ab * ab > 0.98 * dot(da, da) * dot(db, db);
+}
+}  // namespace
+
 bool rays_look_coherent(std::span<const Ray> rays) {
   if (rays.size() < 2) return true;
-  return half_of_samples(rays.size() - 1, [&](std::size_t i) {
-    const Vec3f a = rays[i].dir, b = rays[i + 1].dir;
-    const float ab = dot(a, b);  // cos^2 > 0.98: within about 8 degrees; NaN: not close
-    return ab > 0.0f && ab * ab > 0.98f * dot(a, a) * dot(b, b);
-  });
+  return half_of_samples(rays.size() - 1,
+                         [&](std::size_t i) { return directions_close(rays[i].dir, rays[i + 1].dir); });
 }
 
 bool packet_looks_coherent(std::span<const Ray> rays) {
-  // In double: squared lengths and their products of any finite float
-  // direction neither overflow nor underflow there.
-  const auto d = [](const Vec3f& v) { return std::array<double, 3>{v.x, v.y, v.z}; };
-  const auto dotd = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  };
-  bool first = true;
-  std::array<double, 3> a{};
-  double aa = 0.0;
+  const Vec3f* first = nullptr;
   for (const Ray& r : rays) {
-    const std::array<double, 3> b = d(r.dir);
-    const double bb = dotd(b, b);
-    if (!(bb > 0.0) || !std::isfinite(bb)) continue;  // an invalid lane: it traces nothing
-    if (first) {
-      a = b, aa = bb, first = false;
-      continue;
-    }
-    const double ab = dotd(a, b);  // cos^2 > 0.98: within about 8 degrees
-    if (!(ab > 0.0 && ab * ab > 0.98 * aa * bb)) return false;
+    const double len2 = dot(Vec3d(r.dir), Vec3d(r.dir));
+    if (!(len2 > 0.0) || !std::isfinite(len2)) continue;  // an invalid lane: it traces nothing
+    if (!first) first = &r.dir;
+    else if (!directions_close(*first, r.dir)) return false;
   }
   return true;
 }
@@ -608,14 +602,15 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   // rays in flight across packet boundaries).
   const std::size_t n = rays.size(), w = std::size_t(packet_width);
   const auto coherent = [&](std::size_t at) { return packet_looks_coherent(rays.subspan(at, std::min(w, n - at))); };
+  bool c = coherent(0);  // of the packet at `at`; each packet is tested once
   for (std::size_t at = 0; at < n;) {
-    const bool c = coherent(at);
     std::size_t end = at + w;
-    while (end < n && coherent(end) == c) end += w;
+    bool next = c;
+    while (end < n && (next = coherent(end)) == c) end += w;
     end = std::min(end, n);
     if (c) packets(rays.subspan(at, end - at), hits.subspan(at, end - at));
     else singles(rays.subspan(at, end - at), hits.subspan(at, end - at));
-    at = end;
+    at = end, c = next;
   }
 }
 
