@@ -4,11 +4,13 @@
 // rays bit for bit; exact coverage check of the tree; tree files.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <random>
 #include <set>
 #include <string>
@@ -20,6 +22,7 @@
 #include "bsprt/error.h"
 #include "geometry/io/load_mesh.h"
 #include "geometry/scenes/ray_gen.h"
+#include "robust/certified_intersector.h"
 #include "robust/degenerate.h"
 #include "test_util.h"
 #include "traverse/brute_force.h"
@@ -151,6 +154,31 @@ void check_scene(const TriangleSoup& soup, const std::string& name, std::size_t 
     CHECK(compare_hits(brute_hits(soup, rays), kd_hits(kd, rays), name + " " + what) == 0);
     check_packets(kd, rays);
   }
+  // The same tree with the exact leaf test (the default "kd"): hits equal the
+  // exact reference's, prim and t, on every set (at most 4,000 rays of each),
+  // one ray at a time and in packets.
+  KdTracer exact_kd(tree, soup);
+  const CertifiedIntersector leaf(soup);
+  exact_kd.set_exact_leaf(&leaf);
+  REQUIRE(exact_kd.name() == "kd");
+  const std::unique_ptr<Accelerator> reference = make_tracer("exact", soup);
+  for (const auto& [what, all] : sets) {
+    const std::vector<Ray> rays(all.begin(), all.begin() + std::ptrdiff_t(std::min<std::size_t>(all.size(), 4000)));
+    std::vector<Hit> want(rays.size());
+    reference->trace_batch(rays, want, 1);
+    const std::vector<Hit> got = kd_hits(exact_kd, rays);
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      wrong += got[i].prim != want[i].prim || (want[i].hit() && got[i].t != want[i].t);
+    INFO("exact leaves, " << what);
+    CHECK(wrong == 0);
+    check_packets(exact_kd, rays);
+  }
+  // Switched off, the leaves are float again: the float tracer's hits, bit for bit.
+  exact_kd.set_exact_leaf(nullptr);
+  CHECK(exact_kd.name() == "kd-float");
+  const std::vector<Ray>& some = sets.front().second;
+  CHECK(std::memcmp(kd_hits(exact_kd, some).data(), kd_hits(kd, some).data(), some.size() * sizeof(Hit)) == 0);
 }
 
 TriangleSoup load(const std::string& file) { return load_mesh(test::scene_path(file)); }
