@@ -176,9 +176,11 @@ void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3],
     const unsigned am = movemask<W>(active);
     if (n->is_leaf() && nearest && am != 0 && (am & (am - 1)) == 0) {  // exact leaves, one lane: the scalar test
       const int lane = std::countr_zero(am);
-      const WatertightRay wr = watertight_precompute(rays[lane]);
-      detail::kd_exact_leaf(v, n->prim_offset(), n->prim_offset() + n->prim_count(), rays[lane], wr,
-                            detail::filterable(wr, rays[lane]), nearest[lane], nullptr);
+      if (n->prim_count() != 0) {  // an empty leaf changes nothing
+        const WatertightRay wr = watertight_precompute(rays[lane]);
+        detail::kd_exact_leaf(v, n->prim_offset(), n->prim_offset() + n->prim_count(), rays[lane], wr,
+                              detail::filterable(wr, rays[lane]), nearest[lane], nullptr);
+      }
       hit.t[lane] = cull_bound(nearest[lane]);
     } else if (n->is_leaf()) {
       if (!have_pre) {  // the packet's constants, at its first leaf of two or more lanes

@@ -48,6 +48,9 @@ inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, con
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if (v.exact_leaf) {
     if constexpr (kCount) ++c->leaf_visits;
+    // An empty leaf (most leaves a ray visits in the shared scenes) leaves
+    // `nearest`, and so `hit`, as they are: no call.
+    if (first == end) return;
     detail::kd_exact_leaf(v, first, end, ray, wr, filter, nearest, kCount ? c : nullptr);
     hit.prim = nearest.hit.prim;
     hit.t = cull_bound(nearest);
