@@ -174,6 +174,23 @@ void check_scene(const TriangleSoup& soup, const std::string& name, std::size_t 
     CHECK(wrong == 0);
     check_packets(exact_kd, rays);
   }
+  // On rays that hit nothing no cull bound ever applies, so exact and float
+  // leaves walk the same nodes and leaves, empty leaves included (the exact
+  // path skips the leaf test of an empty leaf but still counts the visit),
+  // and test the same triangles.
+  std::vector<Ray> misses;
+  for (const auto& [what, all] : sets) {
+    const std::vector<Hit> f = kd_hits(kd, all), e = kd_hits(exact_kd, all);
+    for (std::size_t i = 0; i < all.size() && misses.size() < 4000; ++i)
+      if (!f[i].hit() && !e[i].hit()) misses.push_back(all[i]);
+  }
+  CHECK(misses.size() >= 100);
+  RayCounters float_count, exact_count;
+  kd_hits(kd, misses, 1, &float_count);
+  kd_hits(exact_kd, misses, 1, &exact_count);
+  CHECK(exact_count.leaf_visits == float_count.leaf_visits);
+  CHECK(exact_count.kd_node_visits == float_count.kd_node_visits);
+  CHECK(exact_count.triangle_tests == float_count.triangle_tests);
   // Switched off, the leaves are float again: the float tracer's hits, bit for bit.
   exact_kd.set_exact_leaf(nullptr);
   CHECK(exact_kd.name() == "kd-float");
