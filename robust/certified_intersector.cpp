@@ -181,12 +181,28 @@ bool same_corners(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b) 
   return true;
 }
 
+/// Whether two triangles lie in one axis-aligned plane: their six corners
+/// share coordinate k, for some k. Two hits on them then have the same exact
+/// t, (c - o[k]) / d[k] (both lie on the plane; d[k] = 0 would put the ray in
+/// the plane, where it meets neither). Overlapping coplanar surfaces of
+/// architectural models (a panel on a ceiling, a rug on a floor) tie this way:
+/// 97 of the 98 exact decisions on 90K conference camera rays (kd) were such ties.
+bool same_axis_plane(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b) {
+  for (int k = 0; k < 3; ++k) {
+    const float c = a[0][k];
+    if (a[1][k] == c && a[2][k] == c && b[0][k] == c && b[1][k] == c && b[2][k] == c) return true;
+  }
+  return false;
+}
+
 /// Whether two hits have the same exact t for a reason that needs no
-/// arithmetic: the same vertex, the same edge, or triangles with the same corners.
+/// arithmetic: the same vertex, the same edge, triangles with the same
+/// corners, or triangles in the same axis-aligned plane.
 bool same_t_by_rule(const Candidate& c, const std::array<Vec3f, 3>& tri, const NearestHit& best,
                     const std::array<Vec3f, 3>& best_tri) {
-  if ((c.on == 1 && best.on == 1) || (c.on == 2 && best.on == 2)) return detail::same_place(c.on, c.p, c.q, best);
-  return same_corners(tri, best_tri);
+  if (((c.on == 1 && best.on == 1) || (c.on == 2 && best.on == 2)) && detail::same_place(c.on, c.p, c.q, best))
+    return true;
+  return same_corners(tri, best_tri) || same_axis_plane(tri, best_tri);
 }
 
 }  // namespace

@@ -225,6 +225,66 @@ TEST_CASE("exact leaf test: coplanar duplicates with reversed winding tie by rul
   CHECK(counters.rule_decisions == 200);
 }
 
+// Found on conference camera rays (issue #23): 97 of the 98 exact decisions of
+// 90K rays were ties between overlapping triangles in one axis-aligned plane
+// (a panel on the ceiling, z = 595.246), with no corner in common. Such a pair
+// now ties by rule. An exactly coplanar pair in a slanted plane still needs
+// the exact stage, and a pair one float step out of one plane is not a tie.
+TEST_CASE("exact leaf test: overlapping triangles in one axis-aligned plane tie by rule to the lower number",
+          "[exact][exact-leaf][regression]") {
+  const float c = 595.246f;
+  std::mt19937 rng(97);
+  std::uniform_real_distribution<float> u(0.3f, 0.6f);
+  for (int k = 0; k < 3; ++k) {
+    const auto at = [&](float a, float b, float h) {  // (a, b) in the plane, h on axis k
+      Vec3f p;
+      p[k] = h, p[(k + 1) % 3] = a, p[(k + 2) % 3] = b;
+      return p;
+    };
+    for (const float h2 : {c, std::nextafter(c, 1e9f)}) {  // the same plane, then one step above it
+      // 0: a large triangle; 1: a smaller one on it, with no corner in common.
+      const TriangleSoup s = soup_of({{at(-2.0f, -2.0f, c), at(6.0f, -2.0f, c), at(-2.0f, 6.0f, c)},
+                                      {at(0.1f, 0.1f, h2), at(1.5f, 0.15f, h2), at(0.15f, 1.5f, h2)}});
+      const CertifiedIntersector ci(s);
+      RayCounters counters;
+      int ties = 0;
+      for (int i = 0; i < 200; ++i) {
+        const Vec3f target = at(u(rng), u(rng), c);
+        Vec3f o = at(u(rng) - 0.5f, u(rng), c - 10.0f);
+        if (i % 2) o[k] = c + 10.0f;  // from either side
+        const Ray r = make_ray(o, target - o);
+        for (const std::vector<std::uint32_t>& order : {std::vector<std::uint32_t>{1, 0}, {0, 1}}) {
+          const Hit want = reference_nearest(s, r, order);
+          REQUIRE(want.hit());
+          require_same(staged_nearest(ci, r, order, &counters), want);
+          ties += want.prim == 0 && h2 == c;
+        }
+      }
+      INFO("axis " << k << (h2 == c ? ", one plane" : ", one step apart"));
+      if (h2 == c) {
+        CHECK(ties == 400);  // every ray hits both at one t: the lower number wins
+        CHECK(counters.exact_decisions == 0);
+        CHECK(counters.rule_decisions >= 400);
+      } else {
+        CHECK(counters.rule_decisions == 0);  // not one plane: no rule applies
+      }
+    }
+  }
+  // Exactly coplanar in the slanted plane x + y = 1 (dyadic corners): the tie is real,
+  // and only the exact stage can tell.
+  const TriangleSoup s = soup_of({{Vec3f{0.0f, 1.0f, -2.0f}, Vec3f{1.0f, 0.0f, -2.0f}, Vec3f{0.5f, 0.5f, 3.0f}},
+                                  {Vec3f{0.25f, 0.75f, 0.0f}, Vec3f{0.75f, 0.25f, 0.0f}, Vec3f{0.5f, 0.5f, 1.0f}}});
+  const CertifiedIntersector ci(s);
+  RayCounters counters;
+  const Ray r = make_ray({2.0f, 2.0f, 0.25f}, {-1.5f, -1.5f, 0.0f});
+  for (const std::vector<std::uint32_t>& order : {std::vector<std::uint32_t>{1, 0}, {0, 1}}) {
+    const Hit want = reference_nearest(s, r, order);
+    REQUIRE(want.prim == 0);
+    require_same(staged_nearest(ci, r, order, &counters), want);
+  }
+  CHECK(counters.exact_decisions > 0);
+}
+
 TEST_CASE("exact leaf test: degenerate rays and extreme coordinates equal the reference", "[exact][exact-leaf]") {
   std::vector<std::array<Vec3f, 3>> tris = {
       {Vec3f{-1, -1, 1}, Vec3f{3, -1, 1}, Vec3f{-1, 3, 1}},                          // 0: z = 1
