@@ -69,6 +69,11 @@ inline void kd_exact_leaf(const KdView& v, std::uint32_t first, std::uint32_t en
   static_assert(std::is_trivially_copyable_v<LeafTriangle>);
   for (std::uint32_t i = first; i < end; i += 4) {
     const std::uint32_t n = end - i < 4 ? end - i : 4;
+    if (n == 1) {  // one triangle: the double stage on it directly, no gather and no lane filter
+      const std::uint32_t prim = v.prims[i];
+      exact_leaf_staged(*v.exact_leaf, ray, exact_ray_const(ray), &prim, &v.triangles[prim], 1, nearest, c);
+      continue;
+    }
     for (std::uint32_t j = 0; j < n; ++j) {
       const LeafTriangle& t = v.triangles[v.prims[i + j]];
       for (int k = 0; k < 9; ++k) rows[std::uint32_t(k) * n + j] = t.v[k / 3][k % 3];
