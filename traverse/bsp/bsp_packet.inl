@@ -59,6 +59,9 @@ struct BspPacketRay {
   vmask<W> scaled;      ///< lanes traversed in scaled parameters
   vfloat<W> hit_scale;  ///< 2^e of those lanes, 1 elsewhere
   bool any_scaled;      ///< some lane is scaled
+  /// Per axis: 0 when no live lane's neg is set, 1 when every live lane's is,
+  /// 2 when they differ. Below 2, kd nodes on that axis take the kd step.
+  std::uint8_t kd_sign[3];
 };
 
 template <int W>
@@ -98,6 +101,11 @@ inline BspPacketRay<W> packet_setup(const BspView& v, const Ray* rays, int count
   const vmask<W> valid = valid_lanes<W>(p.o, p.dir, p.tnear, p.tfar);
   detail::ray_setup_core(p.o, p.tdir, v.bounds, v.certified, p.inv, p.neg, p.tmin, p.tmax, p.err);
   p.live = valid & (p.tmin <= p.tmax);
+  const unsigned live = movemask<W>(p.live);
+  for (int k = 0; k < 3; ++k) {
+    const unsigned m = movemask<W>(p.neg[k] & p.live);
+    p.kd_sign[k] = std::uint8_t(m == 0 ? 0 : (m == live ? 1 : 2));
+  }
   return p;
 }
 
@@ -180,6 +188,40 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
     while (!n->is_leaf()) {
       __builtin_prefetch(&v.nodes[n->second_child()]);  // as the single-ray step
       vfloat<W> near_hi, far_lo;
+      if (!n->is_plane() && r.kd_sign[n->axis()] < 2) {
+        // A kd node on an axis that every live lane crosses the same way (the
+        // usual case): the kd packet kernel's step. It makes the decisions of
+        // the general step below with a flip the same in every active lane
+        // (no lane redoes the node, the order is the lanes' own), without its
+        // per-lane selects.
+        const int k = n->axis();
+        detail::kd_cut<vfloat<W>>(n->split(), r.o[k], r.inv[k], near_hi, far_lo);
+        if constexpr (kCount) c->kd_node_visits += lanes<W>(active);
+        const bool f = r.kd_sign[k] != 0;  // near is the second child
+        const std::uint32_t first = node + 1, second = n->second_child();
+        const std::uint32_t near = f ? second : first, far = f ? first : second;
+        const bool near_empty = f ? n->second_empty() : n->first_empty();
+        const bool far_empty = f ? n->first_empty() : n->second_empty();
+        const vmask<W> go_near = near_empty ? mask_false<W>() : active & ~(near_hi < tmin);
+        const vmask<W> go_far = far_empty ? mask_false<W>() : active & ~(far_lo > tmax);
+        const vfloat<W> near_max = near_hi < tmax ? near_hi : tmax;
+        if (any<W>(go_far)) {
+          const vfloat<W> far_min = far_lo > tmin ? far_lo : tmin;
+          if (any<W>(go_near)) {
+            stack[sp++] = {far, far_min, tmax, go_far, go_far & go_near};
+            node = near, tmax = near_max, active = go_near;
+          } else {
+            node = far, tmin = far_min, active = go_far;
+          }
+        } else if (any<W>(go_near)) {
+          node = near, tmax = near_max, active = go_near;
+        } else {
+          leaf = false;
+          break;
+        }
+        n = &v.nodes[node];
+        continue;
+      }
       const vmask<W> flip = cut_node<W>(*n, r, near_hi, far_lo);  // per lane: near is the second child
       // Each lane's single-ray decision, in terms of the first and second child.
       const vmask<W> go_own_near = active & ~(near_hi < tmin), go_own_far = active & ~(far_lo > tmax);
