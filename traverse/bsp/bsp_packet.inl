@@ -153,20 +153,6 @@ inline void packet_leaf(const BspView& v, const CompactBspSlot& n, const Waterti
   }
 }
 
-/// The node step for all lanes: conservative near_hi / far_lo, and the lanes
-/// whose near child is the second one.
-template <int W>
-inline vmask<W> cut_node(const CompactBspSlot& n, const BspPacketRay<W>& r, vfloat<W>& near_hi,
-                         vfloat<W>& far_lo) {
-  if (n.is_plane()) {
-    const vfloat<W> b = detail::plane_cut<vfloat<W>>(&n, r.o, r.tdir, r.err, near_hi, far_lo);
-    return b < 0.0f;
-  }
-  const int k = n.axis();
-  detail::kd_cut<vfloat<W>>(n.split(), r.o[k], r.inv[k], near_hi, far_lo);
-  return r.neg[k];
-}
-
 /// Traverses one packet; lanes not live stay misses. The triangle test's
 /// precomputation is made at the first leaf: most packets of a camera that
 /// frames the scene never reach one.
@@ -188,17 +174,34 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
     while (!n->is_leaf()) {
       __builtin_prefetch(&v.nodes[n->second_child()]);  // as the single-ray step
       vfloat<W> near_hi, far_lo;
-      if (!n->is_plane() && r.kd_sign[n->axis()] < 2) {
-        // A kd node on an axis that every live lane crosses the same way (the
-        // usual case): the kd packet kernel's step. It makes the decisions of
-        // the general step below with a flip the same in every active lane
-        // (no lane redoes the node, the order is the lanes' own), without its
-        // per-lane selects.
+      // Per lane: near is the second child (flip). one_way: 0 or 1 when every
+      // active lane agrees on it (false or true), -1 when they differ.
+      vmask<W> flip;
+      int one_way;
+      if (!n->is_plane()) {
         const int k = n->axis();
         detail::kd_cut<vfloat<W>>(n->split(), r.o[k], r.inv[k], near_hi, far_lo);
-        if constexpr (kCount) c->kd_node_visits += lanes<W>(active);
-        const bool f = r.kd_sign[k] != 0;  // near is the second child
-        const std::uint32_t first = node + 1, second = n->second_child();
+        flip = r.neg[k];
+        one_way = r.kd_sign[k] < 2 ? int(r.kd_sign[k]) : -1;  // the usual case, known per packet
+      } else {
+        flip = detail::plane_cut<vfloat<W>>(n, r.o, r.tdir, r.err, near_hi, far_lo) < 0.0f;
+        one_way = -1;
+      }
+      if (one_way < 0) {
+        const unsigned fm = movemask<W>(flip & active), am = movemask<W>(active);
+        one_way = fm == 0 ? 0 : (fm == am ? 1 : -1);
+      }
+      if (one_way >= 0) {
+        // Every active lane takes the same near child: the kd packet kernel's
+        // step. It makes the decisions of the general step below for such a
+        // flip (no lane redoes the node, the order is the lanes' own), without
+        // its per-lane selects.
+        if constexpr (kCount) {
+          if (n->is_plane()) c->bsp_node_visits += lanes<W>(active);
+          else c->kd_node_visits += lanes<W>(active);
+        }
+        const bool f = one_way != 0;
+        const std::uint32_t first = node + n->slots(), second = n->second_child();
         const std::uint32_t near = f ? second : first, far = f ? first : second;
         const bool near_empty = f ? n->second_empty() : n->first_empty();
         const bool far_empty = f ? n->first_empty() : n->second_empty();
@@ -222,7 +225,6 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
         n = &v.nodes[node];
         continue;
       }
-      const vmask<W> flip = cut_node<W>(*n, r, near_hi, far_lo);  // per lane: near is the second child
       // Each lane's single-ray decision, in terms of the first and second child.
       const vmask<W> go_own_near = active & ~(near_hi < tmin), go_own_far = active & ~(far_lo > tmax);
       const vfloat<W> near_max = near_hi < tmax ? near_hi : tmax;
