@@ -125,9 +125,15 @@ struct PacketStageOut {
 };
 
 
-/// Lanes per chunk of the vector stage: four doubles, a native AVX2 vector
-/// (wider GCC vectors of doubles compiled to ten times the instructions).
+/// Lanes per chunk of the vector stage: the ISA's own vector of doubles, four
+/// on AVX2, eight on AVX-512 (wider GCC vectors of doubles than the ISA's
+/// compiled to ten times the instructions). Packets narrower than a chunk
+/// take one chunk of their width.
+#if defined(__AVX512F__)
+inline constexpr int kStageChunk = 8;
+#else
 inline constexpr int kStageChunk = 4;
+#endif
 
 /// double_weights and double_t of the lanes in `need` against triangle `c`
 /// (nine floats, v0 v1 v2), into `out`, four lanes at a time (chunks with no
@@ -136,7 +142,7 @@ template <int W>
 inline void packet_double_stage(const PacketExactRays<W>& r, const std::array<float, 9>& c, unsigned need,
                                 PacketStageOut<W>& out) {
   using namespace exact_stage_detail;
-  constexpr int C = kStageChunk;
+  constexpr int C = W < kStageChunk ? W : kStageChunk;
   using V = vdouble<C>;
   using M = vmask64<C>;
   using F = vfloat<C>;
