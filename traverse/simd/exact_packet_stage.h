@@ -136,7 +136,7 @@ inline constexpr int kStageChunk = 4;
 #endif
 
 /// double_weights and double_t of the lanes in `need` against triangle `c`
-/// (nine floats, v0 v1 v2), into `out`, four lanes at a time (chunks with no
+/// (nine floats, v0 v1 v2), into `out`, kStageChunk lanes at a time (chunks with no
 /// lane in `need` are skipped; their entries are not written). `r` must be uniform.
 template <int W>
 inline void packet_double_stage(const PacketExactRays<W>& r, const std::array<float, 9>& c, unsigned need,
