@@ -97,7 +97,7 @@ TEST_CASE("bench: one row per ray set and mode, with error measured", "[bench]")
   CHECK(row("vertex", "embree").rule_decisions == 0.0);
 }
 
-TEST_CASE("bench: exact against itself has zero error; certified modes lose nothing", "[bench]") {
+TEST_CASE("bench: exact against itself has zero error, and certified modes lose nothing", "[bench]") {
   for (const std::string set : {"primary", "vertex", "inside"}) {
     INFO(set);
     const BenchRow& e = row(set, "exact");

@@ -25,6 +25,7 @@
 #include "bsprt/compare.h"
 #include "geometry/io/load_mesh.h"
 #include "geometry/scenes/ray_gen.h"
+#include "robust/exact_tracer.h"
 #include "test_util.h"
 #include "traverse/simd/cpu_features.h"
 #include "traverse/embree/box_top_build.h"
@@ -829,6 +830,62 @@ TEST_CASE("BSP work per ray: certified vs zero epsilon vs kd-tree", "[bsp][repor
       CHECK(hits(h) >= hits(hz));
       CHECK(hits(h) == hits(hd));  // the kd-tree is conservative too: same hit set
     }
+  }
+}
+
+// Any-hit (Accelerator::occluded): the BSP and the kd-tree stop after the first
+// leaf that yields a hit. The answer must be the exact reference's "hits in
+// [tnear, tfar]" for the exact modes and trace().hit() for the float ones, on
+// rays through vertices and edges, lines, short segments and shadow-like
+// segments between two surface points; the early stop must save work.
+TEST_CASE("bsp and kd: occluded equals the nearest hit's existence and stops early", "[bsp][kd]") {
+  const TriangleSoup soup = load_mesh(scene_path("utah-teapot.obj"));
+  std::vector<Ray> rays;
+  for (RaySetKind k : {RaySetKind::Primary, RaySetKind::Random, RaySetKind::Vertex, RaySetKind::Edge}) {
+    const std::vector<Ray> r = make_rays(k, soup, 400, 61 + std::uint64_t(k));
+    rays.insert(rays.end(), r.begin(), r.end());
+  }
+  const std::size_t base = rays.size();
+  for (std::size_t i = 0; i + 1 < base; i += 4) {
+    Ray line = rays[i];
+    line.tnear = -std::numeric_limits<float>::infinity();
+    rays.push_back(line);
+    Ray seg = rays[i + 1];
+    seg.tfar = 0.5f;
+    rays.push_back(seg);
+  }
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<std::size_t> pick(0, soup.triangles.size() - 1);
+  for (int i = 0; i < 800; ++i) {  // from one surface point to another, t in [1e-4, 1]
+    const auto a = soup.corners(pick(rng)), b = soup.corners(pick(rng));
+    const Vec3f p = (a[0] + a[1] + a[2]) * (1.0f / 3.0f), q = (b[0] + b[1] + b[2]) * (1.0f / 3.0f);
+    Ray r;
+    r.org = p;
+    r.dir = q - p;
+    r.tnear = 1e-4f;
+    r.tfar = 1.0f;
+    rays.push_back(r);
+  }
+  const ExactTracer exact(soup);
+  for (const char* mode : {"bsp", "bsp-float", "kd", "kd-float"}) {
+    const auto t = make_tracer(mode, soup);
+    const bool exact_mode = std::string(mode) == "bsp" || std::string(mode) == "kd";
+    RayCounters nearest, any;
+    std::size_t differ = 0, hits = 0;
+    for (const Ray& r : rays) {
+      const bool h = exact_mode ? exact.trace(r).hit() : t->trace(r, &nearest).hit();
+      if (exact_mode) t->trace(r, &nearest);
+      differ += h != t->occluded(r, &any) ? 1 : 0;
+      hits += h ? 1 : 0;
+    }
+    INFO(mode << ": " << differ << " of " << rays.size() << " rays differ, " << hits << " hit");
+    CHECK(differ == 0);
+    CHECK(hits > rays.size() / 4);
+    CHECK(hits < rays.size());
+    CHECK(any.rays == nearest.rays);
+    CHECK(any.leaf_visits <= nearest.leaf_visits);
+    CHECK(any.triangle_tests < nearest.triangle_tests);
+    CHECK(any.kd_node_visits + any.bsp_node_visits < nearest.kd_node_visits + nearest.bsp_node_visits);
   }
 }
 

@@ -37,7 +37,7 @@ TEST_CASE("camera file: bench/cameras.json holds the interior views", "[camera]"
   CHECK_THROWS_AS(camera_from_spec(kProjectCameras), UsageError);  // two cameras: a name is needed
 }
 
-TEST_CASE("camera file: one camera needs no name; bad files name the file and the problem", "[camera]") {
+TEST_CASE("camera file: one camera needs no name, and bad files name the file and the problem", "[camera]") {
   const std::string one = write_temp("cam-one.json",
                                      R"({"cameras": [{"name": "a", "vp": [0, 0, -5], "vi": [0, 0, 0], "vu": [0, 1, 0], "fov": 45}]})");
   const NamedCamera c = camera_from_spec(one);

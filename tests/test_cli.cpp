@@ -393,7 +393,7 @@ TEST_CASE("stats and trace and verify reject a tree file whose header is corrupt
   }
 }
 
-TEST_CASE("cli: exact leaves are the default; the old names say so; --stats counts the exact stages", "[cli]") {
+TEST_CASE("cli: exact leaves are the default, the old names say so, --stats counts the exact stages", "[cli]") {
   const std::string scene = scene_path("suzanne.obj"), rays = temp_path("cli_default_exact.rays");
   REQUIRE(bsprt_cli("gen-rays " + scene + " --kind vertex -n 2000 --seed 5 -o " + rays).status == 0);
   for (const char* old : {"bsp-certified", "bsp-top-certified"}) {

@@ -166,7 +166,7 @@ TEST_CASE("inside: equals CGAL's Side_of_triangle_mesh on random points, vertice
   CHECK(inside_count > 10000);
 }
 
-TEST_CASE("inside: open meshes are reported; CLI answers per point and rejects bad points files", "[inside][cli]") {
+TEST_CASE("inside: open meshes are reported, and the CLI answers per point and rejects bad points files", "[inside][cli]") {
   CHECK(open_or_inconsistent_edges(make_default_scene()) > 0);  // the ground grid has a border
   const std::string pts = test::temp_path("inside_points.txt"), out = test::temp_path("inside_points.out");
   {
@@ -202,7 +202,7 @@ TEST_CASE("inside: open meshes are reported; CLI answers per point and rejects b
 
 namespace bsprt {
 
-TEST_CASE("trace --all-hits equals exact brute-force crossings; --occluded equals the exact hits", "[inside][cli]") {
+TEST_CASE("trace --all-hits equals exact brute-force crossings, and --occluded equals the exact hits", "[inside][cli]") {
   const std::string scene = test::scene_path("suzanne.obj"), rays = test::temp_path("allhits.rays");
   for (const char* kind : {"vertex", "edge"}) {
     INFO(kind);
@@ -231,12 +231,12 @@ TEST_CASE("trace --all-hits equals exact brute-force crossings; --occluded equal
     for (std::string line; std::getline(in, line);) got.push_back(line);
     CHECK(got.size() > rs.size());  // most rays cross the mesh at least twice
     CHECK(got == want);
-    // --occluded: 1 exactly where the exact reference hits; bsp answers from
-    // its nearest hit, bvh8 from its any-hit traversal (stopped at a first hit).
+    // --occluded: 1 exactly where the exact reference hits; bsp and kd stop at
+    // their first leaf with a hit, bvh8 at its first hit.
     const std::string occ = test::temp_path("allhits.occ"), ref = test::temp_path("allhits.exact.hits");
     REQUIRE(test::bsprt_cli("trace " + scene + " " + rays + " --accel exact -o " + ref).status == 0);
     const std::vector<Hit> exact = read_hits(ref);
-    for (const char* accel : {"bsp", "bvh8"}) {
+    for (const char* accel : {"bsp", "kd", "bvh8"}) {
       INFO(accel);
       REQUIRE(test::bsprt_cli("trace " + scene + " " + rays + " --occluded --accel " + accel + " -o " + occ).status == 0);
       std::ifstream o(occ);

@@ -92,7 +92,7 @@ inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near
 /// interval is empty (NaN crossings cull nothing) or when it lists no
 /// triangle (not stored, bsp_compact.h); a popped cell is skipped when it
 /// starts past the nearest hit. bsp_packet.inl repeats these steps.
-template <bool kCount>
+template <bool kCount, bool kAnyHit = false>
 inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray& ray, const LeafRay& lr,
                              std::uint32_t root, float tmin, float tmax, Hit& hit, NearestHit& nearest,
                              RayCounters* c) {
@@ -134,6 +134,9 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
     }
     if (leaf) {
       intersect_leaf<kCount>(v, *n, ray, lr, hit, nearest, c);
+      if constexpr (kAnyHit) {  // occluded: the first leaf with a hit ends the walk
+        if (v.exact_leaf ? nearest.hit.hit() : hit.hit()) return;
+      }
       best = detail::hit_bound(rc, hit.t);
     }
     if (!detail::pop_before(stack, sp, best, node, tmin, tmax)) return;
@@ -161,12 +164,13 @@ inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& wa
   return v.exact_leaf ? nearest.hit : hit;
 }
 
-/// One ray through the whole tree.
-template <bool kCount>
+/// One ray through the whole tree; kAnyHit: stop at the first leaf with a hit
+/// (occluded), whose hit is some hit in [tnear, tfar], not necessarily the nearest.
+template <bool kCount, bool kAnyHit = false>
 Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
   return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const LeafRay& lr, Hit& hit,
                                           NearestHit& nearest) {
-    traverse_subtree<kCount>(v, rc, ray, lr, 0, rc.tmin, rc.tmax, hit, nearest, c);
+    traverse_subtree<kCount, kAnyHit>(v, rc, ray, lr, 0, rc.tmin, rc.tmax, hit, nearest, c);
   });
 }
 
@@ -624,7 +628,9 @@ bool BspTracer::occluded(const Ray& ray, RayCounters* counters) const {
     WideRay w{&v, &ray, wide_->tree().subtrees.data()};
     return wide_->occluded_with(ray, wide_subtree_call, &w, counters);
   }
-  return trace(ray, counters).hit();
+  if (has_top_ || tree_.bounds.empty()) return trace(ray, counters).hit();
+  const BspView v = make_view(tree_, compact_, triangles_, mode_, exact_leaf_);
+  return (counters ? trace_single<true, true>(v, ray, counters) : trace_single<false, true>(v, ray, nullptr)).hit();
 }
 
 void BspTracer::set_bvh8_top(Bvh8Tree top) {

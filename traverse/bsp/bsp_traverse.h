@@ -150,7 +150,9 @@ class BspTracer final : public Accelerator {
   void shrink_bvh8_top_for_testing() {
     if (wide_) wide_->shrink_boxes_for_testing();
   }
-  /// Any hit: with a BVH8 top its any-hit kernel, else trace(ray).hit().
+  /// Any hit in [tnear, tfar]: with a BVH8 top its any-hit kernel; with a box
+  /// top (bsp-top) trace(ray).hit(); otherwise the traversal of trace, stopped
+  /// after the first leaf that yields a hit (exact leaves decide it exactly).
   bool occluded(const Ray& ray, RayCounters* counters = nullptr) const override;
   /// The leaf lists: triangle numbers and their corners (compact().slots'
   /// prim_offset indexes both).

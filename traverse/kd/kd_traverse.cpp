@@ -75,8 +75,10 @@ inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, con
 /// step measured 30% slower). A popped cell is skipped when its entry is past
 /// the nearest hit. kd_packet.inl repeats these steps lane by lane, bit for bit.
 /// `filter`: exact leaves may use their float prefilter (detail::filterable,
-/// a property of the ray, made once per ray).
-template <bool kCount, bool kNonNegative>
+/// a property of the ray, made once per ray). kAnyHit: stop after the first
+/// leaf that yields a hit (occluded); the hit is then some hit in
+/// [tnear, tfar], not necessarily the nearest.
+template <bool kCount, bool kNonNegative, bool kAnyHit = false>
 Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, bool filter, const float o[3],
                const float inv[3], const bool neg[3], float tmin, float tmax, RayCounters* c) {
   Hit hit;
@@ -107,12 +109,17 @@ Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, bool fi
       if (!detail::step_near_far(near, far, go_near, go_far, th, tl, node, tmin, tmax, stack, sp)) break;
       n = &v.nodes[node];
     }
-    if (n->is_leaf()) intersect_leaf<kCount>(v, *n, ray, wr, filter, hit, nearest, c);
+    if (n->is_leaf()) {
+      intersect_leaf<kCount>(v, *n, ray, wr, filter, hit, nearest, c);
+      if constexpr (kAnyHit) {
+        if (v.exact_leaf ? nearest.hit.hit() : hit.hit()) return v.exact_leaf ? nearest.hit : hit;
+      }
+    }
     if (!detail::pop_before(stack, sp, hit.t, node, tmin, tmax)) return v.exact_leaf ? nearest.hit : hit;
   }
 }
 
-template <bool kCount>
+template <bool kCount, bool kAnyHit = false>
 Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
   Hit hit;
   if constexpr (kCount) ++c->rays;
@@ -127,8 +134,8 @@ Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
   if (!(tmin <= tmax)) return hit;
   const bool filter = v.exact_leaf && detail::filterable(wr, ray);
   const auto walk = [&]() {
-    return tmin >= 0.0f ? trace_from<kCount, true>(v, ray, wr, filter, o, inv, neg, tmin, tmax, c)
-                        : trace_from<kCount, false>(v, ray, wr, filter, o, inv, neg, tmin, tmax, c);
+    return tmin >= 0.0f ? trace_from<kCount, true, kAnyHit>(v, ray, wr, filter, o, inv, neg, tmin, tmax, c)
+                        : trace_from<kCount, false, kAnyHit>(v, ray, wr, filter, o, inv, neg, tmin, tmax, c);
   };
   if constexpr (kCount) {
     const std::uint64_t before = c->exact_decisions;  // set by an exact leaf test
@@ -169,6 +176,11 @@ KdTracer::KdTracer(KdTree tree, const TriangleSoup& soup) : tree_(std::move(tree
 Hit KdTracer::trace(const Ray& ray, RayCounters* counters) const {
   const KdView v{tree_.nodes.data(), tree_.prims.data(), triangles_.data(), tree_.bounds, exact_leaf_};
   return counters ? trace_single<true>(v, ray, counters) : trace_single<false>(v, ray, nullptr);
+}
+
+bool KdTracer::occluded(const Ray& ray, RayCounters* counters) const {
+  const KdView v{tree_.nodes.data(), tree_.prims.data(), triangles_.data(), tree_.bounds, exact_leaf_};
+  return (counters ? trace_single<true, true>(v, ray, counters) : trace_single<false, true>(v, ray, nullptr)).hit();
 }
 
 void KdTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,

@@ -46,6 +46,9 @@ class KdTracer final : public Accelerator {
   /// Single ray, front to back; counts kd_node_visits, leaf_visits,
   /// triangle_tests and rays when `counters` is non-null.
   Hit trace(const Ray& ray, RayCounters* counters = nullptr) const override;
+  /// Any hit in [tnear, tfar]: the traversal of trace, stopped after the first
+  /// leaf that yields a hit (exact leaves decide it exactly, as trace does).
+  bool occluded(const Ray& ray, RayCounters* counters = nullptr) const override;
   /// packet_width 1 = single rays; 4, 8, 16 = SSE4.2, AVX2, AVX-512 packets
   /// (UsageError when the CPU lacks the ISA). Packets whose rays' direction
   /// signs differ are traced as single rays. Counters equal single-ray counters.
