@@ -89,6 +89,17 @@ void trace_timed(const Accelerator& tracer, const std::vector<Ray>& rays, std::v
   ts.rays[bounce] += rays.size();
 }
 
+/// Shadow rays: the tracer's any-hit query (Accelerator::occluded), ray by ray;
+/// books the time and count under `bounce` as trace_timed does.
+void occluded_timed(const Accelerator& tracer, const std::vector<Ray>& rays, std::vector<char>& blocked,
+                    ThreadStats& ts, int bounce) {
+  blocked.resize(rays.size());
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < rays.size(); ++i) blocked[i] = tracer.occluded(rays[i]) ? 1 : 0;
+  ts.seconds[bounce] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ts.rays[bounce] += rays.size();
+}
+
 }  // namespace
 
 namespace {
@@ -173,7 +184,8 @@ void render_tile(const TileJob& job, int x0, int y0, int x1, int y1, Image& imag
         active.push_back(paths.size());
         paths.emplace_back();
       }
-  std::vector<Hit> hits, shadow_hits;
+  std::vector<Hit> hits;
+  std::vector<char> blocked;
   for (int bounce = 0; !active.empty(); ++bounce) {
     trace_timed(job.tracer, rays, hits, bounce == 0 ? job.opt.packet_width : 1, ts, bounce);
     std::vector<Ray> shadow, next;
@@ -181,9 +193,9 @@ void render_tile(const TileJob& job, int x0, int y0, int x1, int y1, Image& imag
     std::vector<Vec3f> shadow_value;
     shade_bounce(job, bounce, active, rays, hits, paths, samplers, shadow, shadow_owner, shadow_value, next,
                  next_owner);
-    trace_timed(job.tracer, shadow, shadow_hits, 1, ts, bounce);
+    occluded_timed(job.tracer, shadow, blocked, ts, bounce);
     for (std::size_t k = 0; k < shadow.size(); ++k)
-      if (!shadow_hits[k].hit()) paths[shadow_owner[k]].radiance += shadow_value[k];
+      if (!blocked[k]) paths[shadow_owner[k]].radiance += shadow_value[k];
     rays = std::move(next);
     active = std::move(next_owner);
   }

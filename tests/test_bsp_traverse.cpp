@@ -887,6 +887,18 @@ TEST_CASE("bsp and kd: occluded equals the nearest hit's existence and stops ear
     CHECK(any.triangle_tests < nearest.triangle_tests);
     CHECK(any.kd_node_visits + any.bsp_node_visits < nearest.kd_node_visits + nearest.bsp_node_visits);
   }
+  // Embree's rtcOccluded1 (the path tracer's shadow rays use occluded in every
+  // mode) against its own nearest hits; Embree takes no lines (tnear < 0).
+  const auto embree = make_tracer("embree", soup);
+  std::size_t differ = 0, checked = 0;
+  for (const Ray& r : rays)
+    if (r.tnear >= 0.0f) {
+      differ += embree->trace(r).hit() != embree->occluded(r) ? 1 : 0;
+      ++checked;
+    }
+  INFO("embree: " << differ << " of " << checked << " rays differ");
+  CHECK(differ == 0);
+  CHECK(checked > rays.size() / 2);
 }
 
 TEST_CASE("BSP comparison catches a tree whose planes were moved", "[bsp]") {

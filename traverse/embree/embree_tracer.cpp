@@ -215,6 +215,17 @@ Hit EmbreeTracer::trace(const Ray& ray, RayCounters* counters) const {
   return trace_checked(*impl_, ray, &ctx);
 }
 
+bool EmbreeTracer::occluded(const Ray& ray, RayCounters* counters) const {
+  if (counters) ++counters->rays;
+  check_embree_domain(ray, 0);
+  if (!is_valid(ray)) return false;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh = to_embree(ray);
+  rtcOccluded1(impl_->scene, &ctx, &rh.ray);
+  return rh.ray.tfar == -std::numeric_limits<float>::infinity();  // Embree's mark of an occluded ray
+}
+
 void EmbreeTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
                                RayCounters* counters) const {
   if (hits.size() != rays.size())

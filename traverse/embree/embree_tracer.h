@@ -37,6 +37,8 @@ class EmbreeTracer final : public Accelerator {
   /// packet_width 4/8/16 uses rtcIntersect4/8/16; 1 uses rtcIntersect1.
   void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width = 1,
                    RayCounters* counters = nullptr) const override;
+  /// rtcOccluded1: Embree's any-hit query (same domain checks as trace).
+  bool occluded(const Ray& ray, RayCounters* counters = nullptr) const override;
   std::size_t memory_bytes() const override;
 
  private:
