@@ -195,7 +195,9 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
         // Every active lane takes the same near child: the kd packet kernel's
         // step. It makes the decisions of the general step below for such a
         // flip (no lane redoes the node, the order is the lanes' own), without
-        // its per-lane selects.
+        // its per-lane selects. It keeps its own copy of the push-and-advance
+        // tail: one tail shared with the general step (the intervals chosen
+        // per branch) measured 8 % slower on sponza atrium packets of 8.
         if constexpr (kCount) {
           if (n->is_plane()) c->bsp_node_visits += lanes<W>(active);
           else c->kd_node_visits += lanes<W>(active);
