@@ -9,8 +9,10 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "bsprt/ray.h"
+#include "traverse/leaf_intersector.h"
 #include "traverse/simd/simd.h"
 #include "traverse/watertight.h"
 
@@ -51,12 +53,12 @@ inline simd::vfloat<W> exact_filter_bound(simd::vfloat<W> mx, simd::vfloat<W> my
   return simd::max<W>(0x1p-18f * (mx * my), scaled * 0x1p-120f);
 }
 
-/// `rows` holds nine rows of `count` (1..4) floats (corner c, axis k at row
-/// 3c + k), each read as four floats: rows[8 count + 3] must be readable.
-inline unsigned exact_lanes(const WatertightRay& r, const float* rows, std::uint32_t count) {
+/// The filter on up to four triangles whose corner rows `lane(c, k)` gives:
+/// the four floats of corner c, axis k (lanes past `count` are masked off).
+template <class Lane>
+inline unsigned exact_lanes_with(const WatertightRay& r, Lane&& lane, std::uint32_t count) {
   using V4 = simd::vfloat<4>;
   using M4 = simd::vmask<4>;
-  const auto lane = [&](int c, int k) { return simd::load<4>(rows + (3 * c + k) * count); };
   const V4 sx = simd::splat<4>(r.sx), sy = simd::splat<4>(r.sy);
   const V4 asx = simd::abs<4>(sx), asy = simd::abs<4>(sy);
   // The origin's sheared axes once (Vec3's operator[] with a run-time axis is a select chain).
@@ -78,6 +80,33 @@ inline unsigned exact_lanes(const WatertightRay& r, const float* rows, std::uint
   const M4 neg = (u < -bound) | (v < -bound) | (w < -bound);
   const unsigned all = (1u << count) - 1u;
   return all & ~simd::movemask<4>(pos & neg);
+}
+
+/// `rows` holds nine rows of `count` (1..4) floats (corner c, axis k at row
+/// 3c + k), each read as four floats: rows[8 count + 3] must be readable.
+inline unsigned exact_lanes(const WatertightRay& r, const float* rows, std::uint32_t count) {
+  return exact_lanes_with(r, [&](int c, int k) { return simd::load<4>(rows + (3 * c + k) * count); }, count);
+}
+
+/// The same on the corners of up to four triangles, given by pointer
+/// (t[j] for j >= count may be any triangle: masked off). The rows are built
+/// in registers from the triangles as stored: a row written to memory float by
+/// float and read back as one vector cannot be forwarded from the stores
+/// (perf: the hottest instructions of the kd-tree's exact leaves on conference
+/// camera rays, when kd_exact_leaf gathered the rows into a buffer).
+inline unsigned exact_lanes(const WatertightRay& r, const LeafTriangle* const (&t)[4], std::uint32_t count) {
+  const auto at = [](const LeafTriangle* p, int i) {
+    float f;
+    std::memcpy(&f, reinterpret_cast<const char*>(p) + sizeof(float) * std::size_t(i), sizeof f);
+    return f;
+  };
+  return exact_lanes_with(
+      r,
+      [&](int c, int k) {
+        const int i = 3 * c + k;
+        return simd::vfloat<4>{at(t[0], i), at(t[1], i), at(t[2], i), at(t[3], i)};
+      },
+      count);
 }
 
 }  // namespace BSPRT_ISA_NAMESPACE

@@ -41,7 +41,7 @@ struct LeafRay {
 };
 inline void leaf_ray_setup(const BspView& v, const Ray& ray, LeafRay& lr) {
   if (v.exact_leaf)
-    lr.er = detail::exact_ray_const(ray);
+    detail::exact_ray_init(ray, lr.er);
   else
     lr.wr = watertight_precompute(ray);
 }

@@ -50,47 +50,35 @@ struct KdView {
 inline namespace BSPRT_ISA_NAMESPACE {  // compiled into per-ISA kernels too (simd.h, ODR)
 
 /// The exact leaf test on leaf entries [first, end) for one ray, four
-/// triangles at a time: their corners (stored by triangle number) gathered
-/// into leaf order, the float prefilter (exact_prefilter.h; when `filter`)
-/// leaving out the certain misses, one call for the rest. The nearest hit and
-/// its tie rule do not depend on how the triangles are grouped, so the answer
-/// is the one-at-a-time answer; left-out triangles still count as tests.
-/// The ray's double constants are made per call, only when some triangle
-/// passes the prefilter (measured: fewer instructions than keeping them per
-/// ray, on sponza camera rays and bunny vertex rays).
+/// triangles at a time: the float prefilter (exact_prefilter.h; when `filter`)
+/// on their corners as stored, leaving out the certain misses, then the
+/// staged exact test on each of the others, in leaf order. The nearest hit
+/// and its tie rule do not depend on how the triangles are grouped, so the
+/// answer is the one-at-a-time answer; left-out triangles still count as
+/// tests. `er` holds the ray's double constants, made at the first triangle
+/// that passes the prefilter (most rays' leaves need none).
+///
+/// Nothing is copied: the prefilter builds its rows in registers, and each
+/// triangle that passes goes to the double stage from where it is stored.
+/// Gathering rows and corners into stack buffers first, float by float, made
+/// every vector read of them a store-forwarding stall (perf, conference camera
+/// rays: the hottest instructions of these leaves).
 inline void kd_exact_leaf(const KdView& v, std::uint32_t first, std::uint32_t end, const Ray& ray,
-                          const WatertightRay& wr, bool filter, NearestHit& nearest, RayCounters* c) {
-  // Neither buffer is zeroed as a whole: GCC clears a 144-byte array with
-  // `rep stos`, whose start-up cost made these two clears the hottest
-  // instructions of the kd-tree's exact leaves (perf, conference camera rays).
-  float rows[36];  // nine rows of n, read four floats at a time: rows[8 n + 3] is the last read
-  alignas(LeafTriangle) unsigned char corner_bytes[4 * sizeof(LeafTriangle)];
-  LeafTriangle* const corners = reinterpret_cast<LeafTriangle*>(corner_bytes);
-  static_assert(std::is_trivially_copyable_v<LeafTriangle>);
+                          const WatertightRay& wr, bool filter, LazyExactRay& er, NearestHit& nearest,
+                          RayCounters* c) {
   for (std::uint32_t i = first; i < end; i += 4) {
     const std::uint32_t n = end - i < 4 ? end - i : 4;
-    if (n == 1) {  // one triangle: the double stage on it directly, no gather and no lane filter
-      const std::uint32_t prim = v.prims[i];
-      exact_leaf_staged(*v.exact_leaf, ray, exact_ray_const(ray), &prim, &v.triangles[prim], 1, nearest, c);
-      continue;
+    unsigned lanes = 1u;
+    if (n > 1) {  // one triangle: the double stage on it directly, no lane filter
+      const LeafTriangle* t[4];
+      for (std::uint32_t j = 0; j < 4; ++j) t[j] = &v.triangles[v.prims[i + (j < n ? j : 0)]];
+      lanes = filter ? exact_lanes(wr, t, n) : (1u << n) - 1u;
+      if (c) c->triangle_tests += n - std::uint32_t(__builtin_popcount(lanes));
     }
-    for (std::uint32_t j = 0; j < n; ++j) {
-      const LeafTriangle& t = v.triangles[v.prims[i + j]];
-      for (int k = 0; k < 9; ++k) rows[std::uint32_t(k) * n + j] = t.v[k / 3][k % 3];
+    for (unsigned bits = lanes; bits != 0; bits &= bits - 1) {
+      const std::uint32_t prim = v.prims[i + std::uint32_t(__builtin_ctz(bits))];
+      exact_leaf_staged(*v.exact_leaf, ray, er.get(ray), &prim, &v.triangles[prim], 1, nearest, c);
     }
-    // The last row's reads past 9 n (n < 4) land in lanes that exact_lanes masks
-    // off; they are still given values.
-    for (std::uint32_t r = 9 * n; r < 8 * n + 4; ++r) rows[r] = 0.0f;
-    const unsigned lanes = filter ? exact_lanes(wr, rows, n) : (1u << n) - 1u;
-    std::uint32_t prims[4];
-    std::uint32_t m = 0;
-    for (unsigned bits = lanes; bits != 0; bits &= bits - 1, ++m) {
-      const std::uint32_t j = std::uint32_t(__builtin_ctz(bits));
-      prims[m] = v.prims[i + j];
-      std::memcpy(static_cast<void*>(corners + m), &v.triangles[prims[m]], sizeof(LeafTriangle));
-    }
-    if (c) c->triangle_tests += n - m;
-    if (m) exact_leaf_staged(*v.exact_leaf, ray, exact_ray_const(ray), prims, corners, m, nearest, c);
   }
 }
 

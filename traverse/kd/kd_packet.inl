@@ -179,7 +179,7 @@ void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3],
       if (n->prim_count() != 0) {  // an empty leaf changes nothing
         const WatertightRay wr = watertight_precompute(rays[lane]);
         detail::kd_exact_leaf(v, n->prim_offset(), n->prim_offset() + n->prim_count(), rays[lane], wr,
-                              detail::filterable(wr, rays[lane]), nearest[lane], nullptr);
+                              detail::filterable(wr, rays[lane]), er[lane], nearest[lane], nullptr);
       }
       hit.t[lane] = cull_bound(nearest[lane]);
     } else if (n->is_leaf()) {

@@ -44,14 +44,14 @@ inline void clip_root(const Box3f& b, const float o[3], const float inv[3], cons
 /// bound (cull_bound).
 template <bool kCount>
 inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, const WatertightRay& wr, bool filter,
-                           Hit& hit, NearestHit& nearest, RayCounters* c) {
+                           Hit& hit, detail::LazyExactRay& er, NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if (v.exact_leaf) {
     if constexpr (kCount) ++c->leaf_visits;
     // An empty leaf (most leaves a ray visits in the shared scenes) leaves
     // `nearest`, and so `hit`, as they are: no call.
     if (first == end) return;
-    detail::kd_exact_leaf(v, first, end, ray, wr, filter, nearest, kCount ? c : nullptr);
+    detail::kd_exact_leaf(v, first, end, ray, wr, filter, er, nearest, kCount ? c : nullptr);
     hit.prim = nearest.hit.prim;
     hit.t = cull_bound(nearest);
     return;
@@ -83,6 +83,7 @@ Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, bool fi
                const float inv[3], const bool neg[3], float tmin, float tmax, RayCounters* c) {
   Hit hit;
   NearestHit nearest;
+  detail::LazyExactRay er;  // exact leaves: the ray's double constants, made on first use
   StackEntry stack[kKdMaxDepth];
   int sp = 0;
   std::uint32_t node = 0;
@@ -110,7 +111,7 @@ Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, bool fi
       n = &v.nodes[node];
     }
     if (n->is_leaf()) {
-      intersect_leaf<kCount>(v, *n, ray, wr, filter, hit, nearest, c);
+      intersect_leaf<kCount>(v, *n, ray, wr, filter, hit, er, nearest, c);
       if constexpr (kAnyHit) {
         if (v.exact_leaf ? nearest.hit.hit() : hit.hit()) return v.exact_leaf ? nearest.hit : hit;
       }
