@@ -26,6 +26,7 @@
 #include "geometry/io/load_mesh.h"
 #include "geometry/scenes/ray_gen.h"
 #include "robust/exact_tracer.h"
+#include "traverse/bsp/bsp_kernel.h"
 #include "test_util.h"
 #include "traverse/simd/cpu_features.h"
 #include "traverse/embree/box_top_build.h"
@@ -342,6 +343,44 @@ TEST_CASE("box top: shrunk boxes lose hits and the comparison sees it", "[bsp]")
   INFO("lost " << c.lost << ", farther " << c.farther << " of " << c.hits);
   CHECK(c.lost + c.farther > 0);
   CHECK_FALSE(c.ok());
+}
+
+TEST_CASE("bsp node widening: without max and min it equals the ordered one except below zero, where the far child starts at tmin",
+          "[bsp]") {
+  using detail::Order;
+  std::mt19937 rng(7);
+  std::vector<float> qs = {0.0f, -0.0f, 0x1p-149f, -0x1p-149f, 0x1p-127f, -0x1p-127f, 0x1p-126f, -0x1p-126f, 1.0f, -1.0f,
+                           std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(),
+                           std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                           std::numeric_limits<float>::quiet_NaN()};
+  for (int i = 0; i < 20000; ++i) qs.push_back(std::bit_cast<float>(std::uint32_t(rng())));  // every exponent
+  const auto same = [](float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b) ||
+                                                  (std::isnan(a) && std::isnan(b)); };
+  std::size_t negative = 0;
+  for (const float q : qs) {
+    const float up_o = detail::widen_up_as<Order::Ordered>(q, false), dn_o = detail::widen_dn_as<Order::Ordered>(q, false);
+    const float up_n = detail::widen_up_as<Order::NonNegative>(q, true),
+                dn_n = detail::widen_dn_as<Order::NonNegative>(q, true);
+    INFO("q = " << q);
+    CHECK(same(up_o, detail::widen_up(q)));
+    CHECK(same(dn_o, detail::widen_dn(q)));
+    // PerLane: the lane's own choice, bit for bit.
+    CHECK(same(detail::widen_up_as<Order::PerLane>(q, true), up_n));
+    CHECK(same(detail::widen_dn_as<Order::PerLane>(q, true), dn_n));
+    CHECK(same(detail::widen_up_as<Order::PerLane>(q, false), up_o));
+    CHECK(same(detail::widen_dn_as<Order::PerLane>(q, false), dn_o));
+    if (std::isnan(q) || std::isinf(q) || !std::signbit(q) || q == 0.0f) {
+      CHECK(same(up_n, up_o));
+      CHECK(same(dn_n, dn_o));
+    } else {
+      // q < 0 and tmin >= 0: the far child is entered from tmin (max(dn, tmin)),
+      // with either widening.
+      ++negative;
+      CHECK(dn_n < 0.0f);
+      CHECK(dn_o < 0.0f);
+    }
+  }
+  CHECK(negative > 5000);
 }
 
 TEST_CASE("BSP packets equal single rays exactly", "[bsp]") {

@@ -110,14 +110,47 @@ inline F widen_dn(F q) {
   return (a < b ? a : b) - kTiny;
 }
 
+/// How a node step widens its crossing q into the near child's upper end up(q)
+/// and the far child's lower end dn(q):
+///  - Ordered: widen_up / widen_dn, max and min of q·(1±2^-21), any ray;
+///  - NonNegative: q·(1+2^-21) + 2^-126 and q·(1-2^-21) − 2^-126, no max or
+///    min, for rays whose clipped segment starts at t >= 0. The two agree bit
+///    for bit unless q is finite and negative; then the computed q has the sign
+///    of the exact crossing (a rounded difference and a rounded quotient or
+///    product keep their signs), so the whole plane side that the far child
+///    takes lies at t >= 0 > q: the far child is entered from tmin (far_min =
+///    max(dn, tmin) = tmin for either dn < 0), and the near child holds no point
+///    of the segment, so whether it is visited changes no hit
+///    (docs/certified-epsilons.md §4);
+///  - PerLane: NonNegative in the lanes of the mask `nonneg`, Ordered in the
+///    others, so a packet lane computes what its single ray computes.
+enum class Order { Ordered, NonNegative, PerLane };
+
+/// up(q) as kOrder says (see Order).
+template <Order kOrder, typename F, typename M>
+inline F widen_up_as(F q, M nonneg) {
+  const F a = q * kWidenHi, b = q * kWidenLo;
+  if constexpr (kOrder == Order::NonNegative) return a + kTiny;
+  else if constexpr (kOrder == Order::Ordered) return (a > b ? a : b) + kTiny;
+  else return (nonneg ? a : (a > b ? a : b)) + kTiny;
+}
+/// dn(q) as kOrder says (see Order).
+template <Order kOrder, typename F, typename M>
+inline F widen_dn_as(F q, M nonneg) {
+  const F a = q * kWidenHi, b = q * kWidenLo;
+  if constexpr (kOrder == Order::NonNegative) return b - kTiny;
+  else if constexpr (kOrder == Order::Ordered) return (a < b ? a : b) - kTiny;
+  else return (nonneg ? b : (a < b ? a : b)) - kTiny;
+}
+
 /// kd node on axis k: crossing t = (split - o_k)·(1/dir_k), widened. Near is the
 /// lower child unless dir_k is negative. dir_k = ±0 gives ±inf (the ray stays on
 /// one side), a ray in the plane gives NaN (both children, whole interval).
-template <typename F>
-inline void kd_cut(float split, F o_k, F inv_k, F& near_hi, F& far_lo) {
+template <typename F, Order kOrder = Order::Ordered, typename M = bool>
+inline void kd_cut(float split, F o_k, F inv_k, F& near_hi, F& far_lo, M nonneg = M{}) {
   const F t = (split - o_k) * inv_k;
-  near_hi = widen_up(t);
-  far_lo = widen_dn(t);
+  near_hi = widen_up_as<kOrder>(t, nonneg);
+  far_lo = widen_dn_as<kOrder>(t, nonneg);
 }
 
 /// Plane node in slots n[0..2] (bsp_compact.h) (docs/certified-epsilons.md
@@ -128,9 +161,10 @@ inline void kd_cut(float split, F o_k, F inv_k, F& near_hi, F& far_lo) {
 /// not depend on the node's interval, so consecutive plane steps do not wait
 /// on each other. The first child (value <= 0) needs a + b·t <= E, the second
 /// a + b·t >= −E. Returns the slope b: near is the first child iff b >= 0.
-template <typename F>
+/// kOrder, nonneg: as for kd_cut.
+template <typename F, Order kOrder = Order::Ordered, typename M = bool>
 inline F plane_cut(const CompactBspSlot* n, const F (&o)[3], const F (&dir)[3], F err, F& near_hi,
-                   F& far_lo) {
+                   F& far_lo, M nonneg = M{}) {
   const float n0 = n->plane_normal(0), n1 = n->plane_normal(1), n2 = n->plane_normal(2), d = n->plane_d(),
               eps = n->plane_eps();
   const F a = ((n0 * o[0] + n1 * o[1]) + n2 * o[2]) + d;
@@ -140,8 +174,8 @@ inline F plane_cut(const CompactBspSlot* n, const F (&o)[3], const F (&dir)[3], 
   const F inv = 1.0f / b;
   const F q_first = (e - a) * inv, q_second = (-e - a) * inv;
   const auto flip = b < 0.0f;
-  near_hi = widen_up(flip ? q_second : q_first);
-  far_lo = widen_dn(flip ? q_first : q_second);
+  near_hi = widen_up_as<kOrder>(flip ? q_second : q_first, nonneg);
+  far_lo = widen_dn_as<kOrder>(flip ? q_first : q_second, nonneg);
   return b;
 }
 

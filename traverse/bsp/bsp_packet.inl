@@ -156,7 +156,7 @@ inline void packet_leaf(const BspView& v, const CompactBspSlot& n, const Waterti
 /// Traverses one packet; lanes not live stay misses. The triangle test's
 /// precomputation is made at the first leaf: most packets of a camera that
 /// frames the scene never reach one.
-template <int W, bool kCount>
+template <int W, bool kCount, detail::Order kOrder>
 void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit, RayCounters* c,
                   const Ray* rays = nullptr, NearestHit* nearest = nullptr, detail::LazyExactRay* er = nullptr) {
   WatertightPacket<W> pre;
@@ -165,6 +165,7 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
   bool have_pre = false;
   vfloat<W> tmin = r.tmin, tmax = r.tmax;
   vmask<W> active = r.live;
+  const vmask<W> nonneg = r.tmin >= 0.0f;  // lanes that widen as detail::Order::NonNegative (kOrder PerLane)
   BspPacketEntry<W> stack[kBspPacketStack];
   int sp = 0;
   std::uint32_t node = 0;
@@ -180,11 +181,11 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
       int one_way;
       if (!n->is_plane()) {
         const int k = n->axis();
-        detail::kd_cut<vfloat<W>>(n->split(), r.o[k], r.inv[k], near_hi, far_lo);
+        detail::kd_cut<vfloat<W>, kOrder>(n->split(), r.o[k], r.inv[k], near_hi, far_lo, nonneg);
         flip = r.neg[k];
         one_way = r.kd_sign[k] < 2 ? int(r.kd_sign[k]) : -1;  // the usual case, known per packet
       } else {
-        flip = detail::plane_cut<vfloat<W>>(n, r.o, r.tdir, r.err, near_hi, far_lo) < 0.0f;
+        flip = detail::plane_cut<vfloat<W>, kOrder>(n, r.o, r.tdir, r.err, near_hi, far_lo, nonneg) < 0.0f;
         one_way = -1;
       }
       if (one_way < 0) {
@@ -308,6 +309,18 @@ void trace_packet(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit,
   }
 }
 
+/// trace_packet with each lane widening as its single ray does (detail::Order):
+/// without max and min when every live lane's segment starts at t >= 0 (camera
+/// and secondary rays), else lane by lane.
+template <int W, bool kCount>
+void trace_packet_as(const BspView& v, const BspPacketRay<W>& r, PacketHit<W>& hit, RayCounters* c,
+                     const Ray* rays = nullptr, NearestHit* nearest = nullptr, detail::LazyExactRay* er = nullptr) {
+  if (none<W>(r.live & ~(r.tmin >= 0.0f)))
+    trace_packet<W, kCount, detail::Order::NonNegative>(v, r, hit, c, rays, nearest, er);
+  else
+    trace_packet<W, kCount, detail::Order::PerLane>(v, r, hit, c, rays, nearest, er);
+}
+
 template <int W, bool kCount>
 void trace_packets(const BspView& v, const Ray* rays, std::size_t n, Hit* hits, RayCounters* c) {
   for (std::size_t base = 0; base < n; base += W) {
@@ -318,11 +331,11 @@ void trace_packets(const BspView& v, const Ray* rays, std::size_t n, Hit* hits, 
     if (v.exact_leaf) {  // exact leaves: never counted here (see packet_exact_leaf)
       NearestHit nearest[W];
       detail::LazyExactRay er[W];
-      if (any<W>(r.live)) trace_packet<W, false>(v, r, hit, nullptr, rays + base, nearest, er);
+      if (any<W>(r.live)) trace_packet_as<W, false>(v, r, hit, nullptr, rays + base, nearest, er);
       for (int i = 0; i < count; ++i) hits[base + std::size_t(i)] = nearest[i].hit;
       continue;
     }
-    if (any<W>(r.live)) trace_packet<W, kCount>(v, r, hit, c);
+    if (any<W>(r.live)) trace_packet_as<W, kCount>(v, r, hit, c);
     store_hits<W>(hit, std::span<Hit>(hits + base, std::size_t(count)));
   }
 }

@@ -77,12 +77,13 @@ inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near
                      RayCounters* c) {
   if (n->is_plane()) {
     if constexpr (kCount) ++c->bsp_node_visits;
-    const float b = detail::plane_cut<float>(n, rc.o, rc.dir, rc.err, near_hi, far_lo);
+    const float b = detail::plane_cut<float, detail::Order::PerLane>(n, rc.o, rc.dir, rc.err, near_hi, far_lo,
+                                                                     rc.tmin >= 0.0f);
     return b < 0.0f;
   }
   if constexpr (kCount) ++c->kd_node_visits;
   const int k = n->axis();
-  detail::kd_cut<float>(n->split(), rc.o[k], rc.inv[k], near_hi, far_lo);
+  detail::kd_cut<float, detail::Order::PerLane>(n->split(), rc.o[k], rc.inv[k], near_hi, far_lo, rc.tmin >= 0.0f);
   return rc.neg[k];
 }
 
@@ -92,7 +93,7 @@ inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near
 /// interval is empty (NaN crossings cull nothing) or when it lists no
 /// triangle (not stored, bsp_compact.h); a popped cell is skipped when it
 /// starts past the nearest hit. bsp_packet.inl repeats these steps.
-template <bool kCount, bool kAnyHit = false>
+template <bool kCount, bool kAnyHit = false, detail::Order kOrder = detail::Order::Ordered>
 inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray& ray, const LeafRay& lr,
                              std::uint32_t root, float tmin, float tmax, Hit& hit, NearestHit& nearest,
                              RayCounters* c) {
@@ -112,12 +113,12 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       std::uint32_t first;
       if (kind < 3) {  // kd (cut_node, with the kind tested once)
         if constexpr (kCount) ++c->kd_node_visits;
-        detail::kd_cut<float>(n->split(), rc.o[kind], rc.inv[kind], near_hi, far_lo);
+        detail::kd_cut<float, kOrder>(n->split(), rc.o[kind], rc.inv[kind], near_hi, far_lo);
         flip = rc.neg[kind];
         first = node + 1;
       } else {
         if constexpr (kCount) ++c->bsp_node_visits;
-        flip = detail::plane_cut<float>(n, rc.o, rc.dir, rc.err, near_hi, far_lo) < 0.0f;
+        flip = detail::plane_cut<float, kOrder>(n, rc.o, rc.dir, rc.err, near_hi, far_lo) < 0.0f;
         first = node + 3;
       }
       const std::uint32_t second = head >> CompactBspSlot::kShift;
@@ -170,7 +171,13 @@ template <bool kCount, bool kAnyHit = false>
 Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
   return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const LeafRay& lr, Hit& hit,
                                           NearestHit& nearest) {
-    traverse_subtree<kCount, kAnyHit>(v, rc, ray, lr, 0, rc.tmin, rc.tmax, hit, nearest, c);
+    // A segment that starts at t >= 0 (camera and secondary rays) widens
+    // without max and min (detail::Order); the packet kernels choose alike.
+    if (rc.tmin >= 0.0f)
+      traverse_subtree<kCount, kAnyHit, detail::Order::NonNegative>(v, rc, ray, lr, 0, rc.tmin, rc.tmax, hit,
+                                                                    nearest, c);
+    else
+      traverse_subtree<kCount, kAnyHit>(v, rc, ray, lr, 0, rc.tmin, rc.tmax, hit, nearest, c);
   });
 }
 
