@@ -55,6 +55,19 @@ struct StageWeights {
 
 inline namespace BSPRT_ISA_NAMESPACE {  // compiled into per-ISA kernels too (simd.h, ODR)
 
+/// Component k of (a, b, c), by selects.
+inline double pick_axis(int k, double a, double b, double c) { return k == 0 ? a : (k == 1 ? b : c); }
+
+/// The shear's axes of direction (dx, dy, dz): kz of the largest |d|, (kx, ky,
+/// kz) cyclic, or swapped when d[kz] < 0 (ExactRayConst).
+inline void exact_axes(double dx, double dy, double dz, int& kx, int& ky, int& kz) {
+  const double ax = std::abs(dx), ay = std::abs(dy), az = std::abs(dz);
+  kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+  kx = kz == 2 ? 0 : kz + 1;
+  ky = kx == 2 ? 0 : kx + 1;
+  if (pick_axis(kz, dx, dy, dz) < 0) std::swap(kx, ky);
+}
+
 /// exact_ray_const(ray), written into `f` in place. The axes pick their
 /// components by selects, not by indexing arrays: an array indexed at run time
 /// lives on the stack, and GCC then copied the finished struct with loads wider
@@ -63,19 +76,15 @@ inline namespace BSPRT_ISA_NAMESPACE {  // compiled into per-ISA kernels too (si
 inline void exact_ray_init(const Ray& ray, ExactRayConst& f) {
   const double dx = ray.dir.x, dy = ray.dir.y, dz = ray.dir.z;
   f.d[0] = dx, f.d[1] = dy, f.d[2] = dz;
-  const double ax = std::abs(dx), ay = std::abs(dy), az = std::abs(dz);
-  const int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
-  int kx = kz == 2 ? 0 : kz + 1;
-  int ky = kx == 2 ? 0 : kx + 1;
-  const auto pick = [](int k, double a, double b, double c) { return k == 0 ? a : (k == 1 ? b : c); };
-  const double dk = pick(kz, dx, dy, dz);
-  if (dk < 0) std::swap(kx, ky);
+  int kx, ky, kz;
+  exact_axes(dx, dy, dz, kx, ky, kz);
+  const double dk = pick_axis(kz, dx, dy, dz);
   f.kx = kx, f.ky = ky, f.kz = kz;
   const double ox = ray.org.x, oy = ray.org.y, oz = ray.org.z;
-  f.ox = pick(kx, ox, oy, oz), f.oy = pick(ky, ox, oy, oz), f.oz = pick(kz, ox, oy, oz);
+  f.ox = pick_axis(kx, ox, oy, oz), f.oy = pick_axis(ky, ox, oy, oz), f.oz = pick_axis(kz, ox, oy, oz);
   f.abs_d = std::abs(dk);
-  f.sx = pick(kx, dx, dy, dz) / dk;
-  f.sy = pick(ky, dx, dy, dz) / dk;
+  f.sx = pick_axis(kx, dx, dy, dz) / dk;
+  f.sy = pick_axis(ky, dx, dy, dz) / dk;
   f.asx = std::abs(f.sx);
   f.asy = std::abs(f.sy);
 }

@@ -96,20 +96,6 @@ inline F gabs(F x) {
 /// compares equal to it.
 inline float gabs(float x) { return std::fabs(x); }
 
-/// Conservative upper end of a crossing parameter (see kWidenHi). NaN stays NaN
-/// and then means "no constraint" at the caller.
-template <typename F>
-inline F widen_up(F q) {
-  const F a = q * kWidenHi, b = q * kWidenLo;
-  return (a > b ? a : b) + kTiny;
-}
-/// Conservative lower end of a crossing parameter.
-template <typename F>
-inline F widen_dn(F q) {
-  const F a = q * kWidenHi, b = q * kWidenLo;
-  return (a < b ? a : b) - kTiny;
-}
-
 /// How a node step widens its crossing q into the near child's upper end up(q)
 /// and the far child's lower end dn(q):
 ///  - Ordered: widen_up / widen_dn, max and min of q·(1±2^-21), any ray;
@@ -141,6 +127,18 @@ inline F widen_dn_as(F q, M nonneg) {
   if constexpr (kOrder == Order::NonNegative) return b - kTiny;
   else if constexpr (kOrder == Order::Ordered) return (a < b ? a : b) - kTiny;
   else return (nonneg ? b : (a < b ? a : b)) - kTiny;
+}
+
+/// Conservative upper end of a crossing parameter (see kWidenHi), for any ray.
+/// NaN stays NaN and then means "no constraint" at the caller.
+template <typename F>
+inline F widen_up(F q) {
+  return widen_up_as<Order::Ordered>(q, false);
+}
+/// Conservative lower end of a crossing parameter, for any ray.
+template <typename F>
+inline F widen_dn(F q) {
+  return widen_dn_as<Order::Ordered>(q, false);
 }
 
 /// kd node on axis k: crossing t = (split - o_k)·(1/dir_k), widened. Near is the

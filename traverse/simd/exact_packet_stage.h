@@ -77,10 +77,8 @@ inline void packet_exact_rays(const Ray* rays, unsigned lanes, PacketExactRays<W
     const int i = __builtin_ctz(m);
     const Ray& ray = rays[i];
     const double d[3] = {ray.dir.x, ray.dir.y, ray.dir.z};
-    const double ax = std::abs(d[0]), ay = std::abs(d[1]), az = std::abs(d[2]);
-    const int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);  // exact_ray_const's choice
-    int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
-    if (d[kz] < 0) std::swap(kx, ky);
+    int kx, ky, kz;
+    detail::exact_axes(d[0], d[1], d[2], kx, ky, kz);  // exact_ray_const's choice
     if (first) {
       p.kx = kx, p.ky = ky, p.kz = kz, first = false;
     } else if (kx != p.kx || ky != p.ky || kz != p.kz) {
