@@ -364,7 +364,8 @@ inline float select_bits(std::uint32_t mask, float a, float b) {
 /// between steps.
 struct Lane {
   BspRayConst rc;
-  LeafRay lr;
+  LeafRay lr;  ///< made at the ray's first leaf (lr_ready): most random rays reach none
+  bool lr_ready;
   Hit hit;
   NearestHit nearest;  ///< exact leaf tests only
   const Ray* ray;
@@ -406,7 +407,10 @@ inline bool lane_step(const BspView& v, Lane& L) {
     L.pop = (go_near | go_far) ^ 1u;
     return false;
   }
-  if (L.pop == 0) intersect_leaf<false>(v, *n, *L.ray, L.lr, L.hit, L.nearest, nullptr);
+  if (L.pop == 0) {
+    if (!L.lr_ready) leaf_ray_setup(v, *L.ray, L.lr), L.lr_ready = true;
+    intersect_leaf<false>(v, *n, *L.ray, L.lr, L.hit, L.nearest, nullptr);
+  }
   const float best = detail::hit_bound(L.rc, L.hit.t);
   for (;;) {
     if (L.sp == 0) return true;
@@ -438,7 +442,7 @@ void trace_interleaved(const BspView& v, const Ray* rays, std::size_t count, Hit
         hits[i] = Hit{};
         continue;
       }
-      leaf_ray_setup(v, rays[i], L.lr);
+      L.lr_ready = false;
       L.hit = Hit{};
       L.nearest = NearestHit{};
       L.ray = &rays[i];
