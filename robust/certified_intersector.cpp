@@ -1,4 +1,5 @@
 #include "robust/certified_intersector.h"
+#include "robust/exact_sum.h"
 
 #include <CGAL/Mpzf.h>
 
@@ -129,7 +130,39 @@ std::optional<Candidate> test_one(const Ray& ray, const ExactRayConst& fr, const
   }
   if (s[0] == 2 || s[1] == 2 || s[2] == 2) {
     // Rule (a): a vertex exactly on the ray's line through o + d or o - d.
-    const bool rule = detail::vertex_rule(fr, ray, floats, sw);
+    bool rule = detail::vertex_rule(fr, ray, floats, sw);
+    // A filter on the volumes from the edges (exact_sum.h), tighter than the
+    // double stage's for a small triangle far from the origin; it and the two
+    // rules after it stay off while a test forces volumes to the exact stage.
+    const bool more = exact_filter_off_for_testing == 0;
+    for (int k = 0; k < 3 && more; ++k) {
+      if (s[k] != 2) continue;
+      double vol, bound;
+      const int sign = detail::edge_volume_filter(tri[(k + 1) % 3], tri[(k + 2) % 3], ray.org, ray.dir, vol, bound);
+      if (sign == 2) continue;
+      s[k] = sign, w[k] = vol / fr.abs_d;  // on the sheared scale, for u and v
+    }
+    // Rule (a) for a vertex anywhere on the ray's line, checked exactly
+    // (exact_sum.h): the two volumes that pair it with the other corners are
+    // 0. Such a corner has both volumes open, or already 0 (a ray along an
+    // edge has two corners on its line).
+    for (int i = 0; i < 3 && more; ++i) {
+      const int k1 = i == 0 ? 1 : 0, k2 = i == 2 ? 1 : 2;  // the volumes that pair corner i
+      const bool zero_or_open = (s[k1] == 2 || s[k1] == 0) && (s[k2] == 2 || s[k2] == 0);
+      if (!zero_or_open || (s[k1] != 2 && s[k2] != 2) || !detail::on_line_exactly(tri[i], ray.org, ray.dir)) continue;
+      s[k1] = s[k2] = 0, w[k1] = w[k2] = 0.0;
+      rule = true;
+    }
+    // Rule (c): a volume of an axis-parallel edge, exactly without the exact
+    // stage (exact_sum.h): the exact zeros of rays through the edges of
+    // architectural models.
+    for (int k = 0; k < 3 && more; ++k) {
+      if (s[k] != 2) continue;
+      double approx;
+      if (!detail::axis_edge_volume_sign(tri[(k + 1) % 3], tri[(k + 2) % 3], ray.org, ray.dir, s[k], approx)) continue;
+      w[k] = s[k] == 0 ? 0.0 : approx / fr.abs_d;  // on the sheared scale, for u and v
+      rule = true;
+    }
     if (s[0] == 2 || s[1] == 2 || s[2] == 2) {  // exact stage for what is still open
       ++st.exact;
       const M3 e0 = msub(tri[0], ray.org), e1 = msub(tri[1], ray.org), e2 = msub(tri[2], ray.org), ed = mvec(ray.dir);
@@ -181,28 +214,78 @@ bool same_corners(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b) 
   return true;
 }
 
-/// Whether two triangles lie in one axis-aligned plane: their six corners
-/// share coordinate k, for some k. Two hits on them then have the same exact
-/// t, (c - o[k]) / d[k] (both lie on the plane; d[k] = 0 would put the ray in
-/// the plane, where it meets neither). Overlapping coplanar surfaces of
-/// architectural models (a panel on a ceiling, a rug on a floor) tie this way:
-/// 97 of the 98 exact decisions on 90K conference camera rays (kd) were such ties.
-bool same_axis_plane(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b) {
-  for (int k = 0; k < 3; ++k) {
-    const float c = a[0][k];
-    if (a[1][k] == c && a[2][k] == c && b[0][k] == c && b[1][k] == c && b[2][k] == c) return true;
+/// The points a hit is known to lie among, by its place (NearestHit::on):
+/// its vertex, the two ends of its edge, or its triangle's three corners.
+/// The hit lies in their convex hull, so in any plane that holds them all.
+int known_points(std::uint8_t on, const Vec3f& p, const Vec3f& q, const std::array<Vec3f, 3>& tri, Vec3f (&out)[3]) {
+  if (on == 1) return out[0] = p, 1;
+  if (on == 2) return out[0] = p, out[1] = q, 2;
+  out[0] = tri[0], out[1] = tri[1], out[2] = tri[2];
+  return 3;
+}
+
+/// Whether two hits lie in one plane parallel to a coordinate axis k, which
+/// the ray crosses: projected along k (coordinates u, v), the points each hit
+/// is known to lie among (known_points) lie on one line L through two of
+/// them, a and b, and the ray's direction is not parallel to L. Both hits
+/// then lie on the plane L x axis k, which the ray meets in one point, so
+/// their exact t's are equal. Each test is the exact sign of a sum of
+/// products of floats (exact_sum.h). An axis-aligned plane x_k = c (every
+/// point's coordinate k equal, d[k] != 0) is the common case, checked first:
+/// overlapping coplanar surfaces of architectural models (a panel on a
+/// ceiling, a rug on a floor); 97 of the 98 exact decisions on 90K conference
+/// camera rays (kd) were such ties. Vertical walls and what hangs on them
+/// (conference's slanted walls) are the planes parallel to one axis.
+bool same_plane_along_axis(const Candidate& c, const std::array<Vec3f, 3>& tri, const NearestHit& best,
+                           const std::array<Vec3f, 3>& best_tri, const Ray& ray) {
+  Vec3f pt[6];
+  Vec3f a3[3], b3[3];
+  const int na = known_points(c.on, c.p, c.q, tri, a3), nb = known_points(best.on, best.p, best.q, best_tri, b3);
+  int n = 0;
+  for (int i = 0; i < na; ++i) pt[n++] = a3[i];
+  for (int i = 0; i < nb; ++i) pt[n++] = b3[i];
+  const Vec3f& d = ray.dir;
+  for (int k = 0; k < 3; ++k) {  // x_k = c
+    bool same = d[k] != 0.0f;
+    for (int i = 1; i < n && same; ++i) same = pt[i][k] == pt[0][k];
+    if (same) return true;
+  }
+  for (int k = 0; k < 3; ++k) {  // a plane containing axis k
+    const int u = (k + 1) % 3, v = (k + 2) % 3;
+    const Vec3f& a = pt[0];
+    int ib = -1;
+    for (int i = 1; i < n && ib < 0; ++i)
+      if (pt[i][u] != a[u] || pt[i][v] != a[v]) ib = i;
+    if (ib < 0) continue;
+    const Vec3f& b = pt[ib];
+    const auto f = [](float x, float y) { return double(x) * double(y); };
+    double approx;
+    // (b - a) x d, projected: not parallel
+    if (detail::exact_sum_sign(std::array<double, 4>{f(b[u], d[v]), -f(a[u], d[v]), -f(b[v], d[u]), f(a[v], d[u])},
+                               approx) == 0)
+      continue;
+    bool on_line = true;
+    for (int i = 1; i < n && on_line; ++i) {
+      if (i == ib) continue;
+      const Vec3f& p = pt[i];  // (b - a) x (p - a), projected, with a[u] a[v] cancelled
+      on_line = detail::exact_sum_sign(std::array<double, 6>{f(b[u], p[v]), -f(b[u], a[v]), -f(a[u], p[v]),
+                                                             -f(b[v], p[u]), f(b[v], a[u]), f(a[v], p[u])},
+                                       approx) == 0;
+    }
+    if (on_line) return true;
   }
   return false;
 }
 
 /// Whether two hits have the same exact t for a reason that needs no
-/// arithmetic: the same vertex, the same edge, triangles with the same
-/// corners, or triangles in the same axis-aligned plane.
+/// arithmetic beyond exact signs of sums of float products: the same vertex,
+/// the same edge, triangles with the same corners, or hits in one plane
+/// parallel to a coordinate axis that the ray crosses.
 bool same_t_by_rule(const Candidate& c, const std::array<Vec3f, 3>& tri, const NearestHit& best,
-                    const std::array<Vec3f, 3>& best_tri) {
+                    const std::array<Vec3f, 3>& best_tri, const Ray& ray) {
   if (((c.on == 1 && best.on == 1) || (c.on == 2 && best.on == 2)) && detail::same_place(c.on, c.p, c.q, best))
     return true;
-  return same_corners(tri, best_tri) || same_axis_plane(tri, best_tri);
+  return same_corners(tri, best_tri) || same_plane_along_axis(c, tri, best, best_tri, ray);
 }
 
 }  // namespace
@@ -241,7 +324,7 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     } else {  // enclosures overlap
       const auto best_tri = soup_.corners(best.hit.prim);
       int order;  // sign(t - best t)
-      if (same_t_by_rule(*c, tri, best, best_tri)) {
+      if (same_t_by_rule(*c, tri, best, best_tri, ray)) {
         ++st.rule;
         order = 0;
       } else {

@@ -22,6 +22,7 @@
 #include "robust/certified_intersector.h"
 #include "robust/degenerate.h"
 #include "robust/nearest_float.h"
+#include "robust/exact_sum.h"
 #include "traverse/exact_double_stage.h"
 #include "test_util.h"
 
@@ -270,19 +271,39 @@ TEST_CASE("exact leaf test: overlapping triangles in one axis-aligned plane tie 
       }
     }
   }
-  // Exactly coplanar in the slanted plane x + y = 1 (dyadic corners): the tie is real,
-  // and only the exact stage can tell.
-  const TriangleSoup s = soup_of({{Vec3f{0.0f, 1.0f, -2.0f}, Vec3f{1.0f, 0.0f, -2.0f}, Vec3f{0.5f, 0.5f, 3.0f}},
-                                  {Vec3f{0.25f, 0.75f, 0.0f}, Vec3f{0.75f, 0.25f, 0.0f}, Vec3f{0.5f, 0.5f, 1.0f}}});
-  const CertifiedIntersector ci(s);
-  RayCounters counters;
-  const Ray r = make_ray({2.0f, 2.0f, 0.25f}, {-1.5f, -1.5f, 0.0f});
-  for (const std::vector<std::uint32_t>& order : {std::vector<std::uint32_t>{1, 0}, {0, 1}}) {
-    const Hit want = reference_nearest(s, r, order);
-    REQUIRE(want.prim == 0);
-    require_same(staged_nearest(ci, r, order, &counters), want);
+  // Exactly coplanar in the slanted plane x + y = 1 (dyadic corners), which
+  // contains the z axis: the tie is real, and the rule for planes along an
+  // axis settles it (the ray's direction, projected along z, crosses the line
+  // x + y = 1).
+  {
+    const TriangleSoup s = soup_of({{Vec3f{0.0f, 1.0f, -2.0f}, Vec3f{1.0f, 0.0f, -2.0f}, Vec3f{0.5f, 0.5f, 3.0f}},
+                                    {Vec3f{0.25f, 0.75f, 0.0f}, Vec3f{0.75f, 0.25f, 0.0f}, Vec3f{0.5f, 0.5f, 1.0f}}});
+    const CertifiedIntersector ci(s);
+    RayCounters counters;
+    const Ray r = make_ray({2.0f, 2.0f, 0.25f}, {-1.5f, -1.5f, 0.0f});
+    for (const std::vector<std::uint32_t>& order : {std::vector<std::uint32_t>{1, 0}, {0, 1}}) {
+      const Hit want = reference_nearest(s, r, order);
+      REQUIRE(want.prim == 0);
+      require_same(staged_nearest(ci, r, order, &counters), want);
+    }
+    CHECK(counters.exact_decisions == 0);
+    CHECK(counters.rule_decisions >= 1);
   }
-  CHECK(counters.exact_decisions > 0);
+  // Exactly coplanar in x + y + z = 1, a plane along no axis: only the exact stage can tell.
+  {
+    const TriangleSoup s = soup_of({{Vec3f{2.0f, -1.0f, 0.0f}, Vec3f{-1.0f, 2.0f, 0.0f}, Vec3f{0.0f, -1.0f, 2.0f}},
+                                    {Vec3f{0.5f, 0.25f, 0.25f}, Vec3f{0.25f, 0.5f, 0.25f}, Vec3f{0.25f, 0.25f, 0.5f}}});
+    const CertifiedIntersector ci(s);
+    RayCounters counters;
+    const Vec3f o{2.0f, 2.0f, 0.375f};
+    const Ray r = make_ray(o, Vec3f{0.3125f, 0.3125f, 0.375f} - o);
+    for (const std::vector<std::uint32_t>& order : {std::vector<std::uint32_t>{1, 0}, {0, 1}}) {
+      const Hit want = reference_nearest(s, r, order);
+      REQUIRE(want.prim == 0);
+      require_same(staged_nearest(ci, r, order, &counters), want);
+    }
+    CHECK(counters.exact_decisions > 0);
+  }
 }
 
 TEST_CASE("exact leaf test: degenerate rays and extreme coordinates equal the reference", "[exact][exact-leaf]") {
@@ -459,6 +480,203 @@ TEST_CASE("staged exact leaf: equals the certified intersector, field for field 
   require_staged_equals_intersector(c, s, r, {all}, off);
   CertifiedIntersector::set_filter_off_for_testing(0);
   CHECK(off.exact_decisions > 0);
+}
+
+}  // namespace bsprt
+
+namespace bsprt {
+namespace {
+
+Q plucker(const Vec3f& p, const Vec3f& q, const Ray& r) {  // ((p - o) x (q - o))·d, exactly
+  const Q3 o = q3(r.org);
+  return qdot(qcross(qsub(q3(p), o), qsub(q3(q), o)), q3(r.dir));
+}
+
+}  // namespace
+
+TEST_CASE("exact sum: signs of sums of float products, the axis-edge volume and the on-line test equal Exact_rational's",
+          "[exact][exact-leaf]") {
+  std::mt19937 rng(1205);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::uniform_int_distribution<int> expo(-60, 60), pick(0, 3);
+  std::uniform_real_distribution<float> bary(0.0f, 1.0f);
+  const auto rnd = [&] { return std::ldexp(unit(rng), expo(rng)); };
+  int zeros = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // Four products of floats, some cancelling exactly or nearly.
+    float a[4], b[4];
+    for (int k = 0; k < 4; ++k) a[k] = rnd(), b[k] = rnd();
+    const int mode = pick(rng);
+    if (mode <= 1) a[1] = -a[0], b[1] = b[0];                                 // a pair that cancels
+    if (mode == 0) a[3] = -a[2], b[3] = b[2];                                 // and another: the sum is 0
+    if (mode == 1) a[3] = a[2], b[3] = -std::nextafter(b[2], 2.0f * b[2]);  // nearly: one float step
+    std::array<double, 4> t;
+    Q sum(0);
+    for (int k = 0; k < 4; ++k) t[k] = double(a[k]) * double(b[k]), sum += Q(double(a[k])) * Q(double(b[k]));
+    double approx;
+    const int s = detail::exact_sum_sign(t, approx);
+    REQUIRE(s == CGAL::sign(sum));
+    REQUIRE((approx > 0) - (approx < 0) == s);
+    zeros += s == 0;
+  }
+  CHECK(zeros > 100);  // the exact zeros were exercised
+
+  // Rule (c) and the edge filter against the exact Plücker volume: axis-parallel
+  // edges, rays through them exactly (dyadic coordinates) and near them.
+  int decided = 0, exact_zero = 0;
+  std::uniform_int_distribution<int> grid(-64, 64), axis(0, 2);
+  for (int i = 0; i < 20000; ++i) {
+    const int j = axis(rng);
+    Vec3f p{grid(rng) * 0.25f, grid(rng) * 0.25f, grid(rng) * 0.25f}, q = p;
+    q[j] += float(grid(rng) | 1) * 0.125f;
+    Vec3f target = p + (q - p) * (float(grid(rng)) / 64.0f);  // on the edge's line, dyadic: exact
+    if (i % 3 == 1) target[(j + 1) % 3] = std::nextafter(target[(j + 1) % 3], 1e9f);  // one step off it
+    if (i % 3 == 2) target = target + Vec3f{unit(rng), unit(rng), unit(rng)};          // anywhere
+    const Vec3f o{grid(rng) * 0.5f + 0.25f, grid(rng) * 0.5f, grid(rng) * 0.5f + 40.0f};
+    const Ray r = make_ray(o, target - o);
+    if (!is_valid(r)) continue;
+    const int want = CGAL::sign(plucker(p, q, r));
+    int s;
+    double approx;
+    REQUIRE(detail::axis_edge_volume_sign(p, q, r.org, r.dir, s, approx));
+    REQUIRE(s == want);
+    REQUIRE((approx > 0) - (approx < 0) == s);
+    exact_zero += want == 0;
+    double vol, bound;
+    const int f = detail::edge_volume_filter(p, q, r.org, r.dir, vol, bound);
+    if (f != 2) {
+      REQUIRE(f == want);
+      ++decided;
+    }
+    // A slanted edge is not rule (c)'s.
+    Vec3f q2 = q;
+    q2[(j + 1) % 3] += 0.5f;
+    REQUIRE_FALSE(detail::axis_edge_volume_sign(p, q2, r.org, r.dir, s, approx));
+  }
+  CHECK(exact_zero > 3000);
+  CHECK(decided > 8000);
+
+  // The edge filter on small slanted edges far from the origin, with full
+  // mantissas, and rays aimed at the edge through a rounded direction: the
+  // volumes are tiny, and the double evaluation rounds.
+  int filter_decided = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3f p{unit(rng) * 100.0f, unit(rng) * 100.0f, unit(rng) * 100.0f};
+    const Vec3f q = p + Vec3f{unit(rng), unit(rng), unit(rng)} * 1e-3f;
+    const Vec3f o{unit(rng) * 1000.0f, unit(rng) * 1000.0f, unit(rng) * 1000.0f};
+    const Ray r = make_ray(o, p + (q - p) * bary(rng) - o);
+    double vol, bound;
+    const int f = detail::edge_volume_filter(p, q, r.org, r.dir, vol, bound);
+    // The error is below 7.1 u M, and the bound is 32 u M.
+    const Q exact = plucker(p, q, r), err = Q(vol) - exact;
+    REQUIRE(CGAL::abs(err) <= Q(bound) / 4);
+    if (f == 2) continue;
+    REQUIRE(f == CGAL::sign(exact));
+    ++filter_decided;
+  }
+  CHECK(filter_decided > 15000);
+
+  // The on-line test: points exactly on the line at dyadic t, and one float step off it.
+  for (int i = 0; i < 5000; ++i) {
+    const Vec3f o{grid(rng) * 0.5f, grid(rng) * 0.5f, grid(rng) * 0.5f};
+    const Vec3f d{grid(rng) * 0.25f, grid(rng) * 0.25f, float(grid(rng) | 1) * 0.25f};
+    Vec3f p = o + d * (float(grid(rng)) / 8.0f);
+    const bool off = i % 2 == 1;
+    if (off) p.x = std::nextafter(p.x, 1e9f);
+    const Q3 c = qcross(qsub(q3(p), q3(o)), q3(d));
+    const bool want = c[0] == 0 && c[1] == 0 && c[2] == 0;
+    REQUIRE(detail::on_line_exactly(p, o, d) == want);
+    if (!off) REQUIRE(want);
+  }
+}
+
+TEST_CASE("exact leaf test: rays through axis-parallel edges, through vertices at any t, and ties in planes along an axis "
+          "need no exact stage (sponza and conference vertex and edge rays)",
+          "[exact][exact-leaf][regression]") {
+  // An architectural soup: a floor of axis-aligned squares in z = 0 (two
+  // triangles each), a slanted wall in the plane x + y = 4 (it contains the z
+  // axis), and a poster on the wall, overlapping it.
+  std::vector<std::array<Vec3f, 3>> tris;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const float x = float(i), y = float(j);
+      tris.push_back({Vec3f{x, y, 0}, Vec3f{x + 1, y, 0}, Vec3f{x + 1, y + 1, 0}});
+      tris.push_back({Vec3f{x, y, 0}, Vec3f{x + 1, y + 1, 0}, Vec3f{x, y + 1, 0}});
+    }
+  tris.push_back({Vec3f{4, 0, 0}, Vec3f{0, 4, 0}, Vec3f{2, 2, 3}});         // the wall
+  tris.push_back({Vec3f{2.5f, 1.5f, 0.5f}, Vec3f{1.5f, 2.5f, 0.5f}, Vec3f{2, 2, 1.5f}});  // the poster
+  const TriangleSoup s = soup_of(tris);
+  const CertifiedIntersector ci(s);
+  std::vector<std::uint32_t> all(s.size());
+  for (std::uint32_t i = 0; i < s.size(); ++i) all[i] = i;
+  RayCounters counters;
+  std::mt19937 rng(46);
+  std::uniform_int_distribution<int> g(1, 15), h(1, 7);
+  int rays = 0;
+  for (int i = 0; i < 3000; ++i) {
+    Vec3f target;
+    const int kind = i % 3;
+    if (kind == 0) target = Vec3f{float(g(rng)) / 4.0f, float(h(rng) % 4), 0.0f};  // on an edge along x
+    if (kind == 1) target = Vec3f{float(h(rng) % 4), float(h(rng) % 4), 0.0f};    // a floor vertex
+    if (kind == 2) {  // on the poster
+      const float a = float(g(rng)) / 32.0f;
+      target = Vec3f{2.0f + a, 2.0f - a, 0.75f};
+    }
+    const Vec3f o{float(g(rng)) - 6.0f, float(g(rng)) - 6.0f, float(h(rng)) + 4.0f};
+    // Directions that reach the target at t = 2 or 4, not 1: rule (a) alone would not see the vertex.
+    const Ray r = make_ray(o, (target - o) * (i % 2 ? 0.5f : 0.25f));
+    // A line coplanar with a slanted edge (its ends differ in two coordinates
+    // or three) has an exact zero that none of these rules covers: the wall's
+    // foot x + y = 4, the floor's diagonals, the poster's edges, a ray in the
+    // wall's plane. The dyadic rays meet such edges often; they are left to
+    // the exact stage and not counted here.
+    bool slanted_zero = false;
+    for (const auto& t : tris)
+      for (int e = 0; e < 3; ++e) {
+        const Vec3f &p = t[e], &q = t[(e + 1) % 3];
+        const int same = int(p.x == q.x) + int(p.y == q.y) + int(p.z == q.z);
+        slanted_zero = slanted_zero || (same < 2 && plucker(p, q, r) == 0);
+      }
+    RayCounters one;
+    const Hit want = reference_nearest(s, r, all);
+    require_same(staged_nearest(ci, r, all, &one), want);
+    if (slanted_zero) continue;
+    counters.rule_decisions += one.rule_decisions;
+    counters.exact_decisions += one.exact_decisions;
+    rays += want.hit();
+  }
+  CHECK(rays > 1500);
+  CHECK(counters.rule_decisions > 1000);
+  CHECK(counters.exact_decisions == 0);
+  // A pyramid's apex, where only slanted edges meet, hit at t = 2: the
+  // on-line test (rule (a) at any t) makes the two volumes at the apex 0, and
+  // the four hits tie at the same vertex.
+  {
+    const Vec3f apex{1.0f, 1.0f, 2.0f};
+    const std::vector<std::array<Vec3f, 3>> pyr{{Vec3f{0, 0, 0}, Vec3f{2, 0, 0}, apex},
+                                                {Vec3f{2, 0, 0}, Vec3f{2, 2, 0}, apex},
+                                                {Vec3f{2, 2, 0}, Vec3f{0, 2, 0}, apex},
+                                                {Vec3f{0, 2, 0}, Vec3f{0, 0, 0}, apex}};
+    const TriangleSoup ps = soup_of(pyr);
+    const CertifiedIntersector pc(ps);
+    const std::vector<std::uint32_t> four{0, 1, 2, 3};
+    RayCounters apex_counters;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3f o{float(g(rng)) - 8.0f, float(g(rng)) - 8.0f, float(h(rng)) + 3.0f};
+      const Ray r = make_ray(o, (apex - o) * 0.5f);
+      const Hit want = reference_nearest(ps, r, four);
+      REQUIRE(want.hit());
+      require_same(staged_nearest(pc, r, four, &apex_counters), want);
+    }
+    CHECK(apex_counters.exact_decisions == 0);
+    CHECK(apex_counters.rule_decisions >= 200);
+  }
+  // Exactly through the wall's slanted foot: an exact zero no rule covers.
+  RayCounters foot;
+  const Vec3f o{-3.0f, -2.0f, 6.0f};
+  const Ray r = make_ray(o, (Vec3f{2.5f, 1.5f, 0.0f} - o) * 0.5f);
+  require_same(staged_nearest(ci, r, all, &foot), reference_nearest(s, r, all));
+  CHECK(foot.exact_decisions > 0);
 }
 
 }  // namespace bsprt
