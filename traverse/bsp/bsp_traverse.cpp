@@ -123,9 +123,12 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       }
       const std::uint32_t second = head >> CompactBspSlot::kShift;
       const std::uint32_t near = flip ? second : first, far = flip ? first : second;
-      const unsigned empties = head >> 3;  // bit 0: the first child is empty, bit 1: the second
-      const bool near_empty = ((empties >> unsigned(flip)) & 1u) != 0;
-      const bool far_empty = ((empties >> unsigned(!flip)) & 1u) != 0;
+      // Empty children, selected like near and far (fixed masks, then
+      // selects) rather than shifted by flip: a variable shift count costs
+      // moves into cl on the base ISA.
+      const bool first_empty = (head & CompactBspSlot::kFirstEmpty) != 0;
+      const bool second_empty = (head & CompactBspSlot::kSecondEmpty) != 0;
+      const bool near_empty = flip ? second_empty : first_empty, far_empty = flip ? first_empty : second_empty;
       const bool go_near = !(near_hi < tmin) && !near_empty, go_far = !(far_lo > tmax) && !far_empty;  // NaN: both
       if (!detail::step_near_far(near, far, go_near, go_far, near_hi, far_lo, node, tmin, tmax, stack, sp)) {
         leaf = false;
