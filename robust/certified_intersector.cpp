@@ -260,10 +260,8 @@ bool same_plane_along_axis(const Candidate& c, const std::array<Vec3f, 3>& tri, 
     const Vec3f& b = pt[ib];
     const auto f = [](float x, float y) { return double(x) * double(y); };
     double approx;
-    // (b - a) x d, projected: not parallel
-    if (detail::exact_sum_sign(std::array<double, 4>{f(b[u], d[v]), -f(a[u], d[v]), -f(b[v], d[u]), f(a[v], d[u])},
-                               approx) == 0)
-      continue;
+    // ((b - a) x d)[k]: the projected direction is not parallel to L
+    if (detail::exact_sum_sign(detail::cross_terms(b, a, d, k), approx) == 0) continue;
     bool on_line = true;
     for (int i = 1; i < n && on_line; ++i) {
       if (i == ib) continue;
