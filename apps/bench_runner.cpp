@@ -24,6 +24,7 @@
 #include "geometry/scenes/camera.h"
 #include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
+#include "apps/cli_common.h"
 #include "geometry/io/load_mesh.h"
 #include "geometry/scenes/ray_gen.h"
 #include "robust/exact_tracer.h"
@@ -266,7 +267,13 @@ double median_t_ulps(const std::vector<Hit>& reference, const std::vector<Hit>& 
 
 BenchScene load_bench_scene(const std::string& spec) {
   BenchScene scene;
-  if (spec.empty() || spec == "default") {
+  if (spec.rfind(cli::kTwinPrefix, 0) == 0) {
+    const std::string inner = spec.substr(cli::kTwinPrefix.size());
+    if (inner.empty()) throw UsageError("bench: expected twin:SCENE, not '" + spec + "'");
+    scene = load_bench_scene(inner);
+    scene.name += "-twins";
+    scene.soup = with_reversed_copies(scene.soup);
+  } else if (spec.empty() || spec == "default") {
     scene.name = "default";
     scene.soup = make_default_scene();
   } else if (spec.rfind("icosphere:", 0) == 0) {

@@ -36,7 +36,9 @@ struct BenchScene {
   std::optional<std::pair<Vec3f, float>> inside_ball;
 };
 
-/// Loads a scene spec: a mesh path, "default", or "icosphere:L" (L = 0..9).
+/// Loads a scene spec: a mesh path, "default", "icosphere:L" (L = 0..9), or
+/// "twin:SPEC" (SPEC's triangles listed twice, the copies reversed; named
+/// "NAME-twins").
 /// Throws InputError / UsageError on bad input.
 BenchScene load_bench_scene(const std::string& spec);
 

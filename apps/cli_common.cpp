@@ -38,6 +38,15 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
 }
 
 TriangleSoup load_scene(const std::string& path, bool allow_nonfinite, bool verbose) {
+  if (path.rfind(kTwinPrefix, 0) == 0) {
+    const std::string file = path.substr(kTwinPrefix.size());
+    if (file.empty()) throw UsageError("expected twin:FILE (a mesh whose triangles are listed twice), not 'twin:'");
+    TriangleSoup soup = with_reversed_copies(load_scene(file, allow_nonfinite, verbose));
+    if (verbose)
+      fmt::print(stderr, "scene: every triangle listed twice (copy n + i = triangle i reversed): {} triangles\n",
+                 soup.size());
+    return soup;
+  }
   if (path.empty() || path == "default") {
     TriangleSoup soup = make_default_scene();
     if (verbose)

@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "builder/accel_factory.h"
@@ -32,8 +33,17 @@ struct TraceOptions {
 /// --single-rays, --allow-nonfinite to `cmd`.
 void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& default_accel);
 
+/// Scene spec prefix: "twin:FILE" is FILE with every triangle listed twice,
+/// the copy with reversed winding (with_reversed_copies).
+inline constexpr std::string_view kTwinPrefix = "twin:";
+/// Help text of a SCENE argument that load_scene reads.
+inline constexpr const char* kSceneHelp =
+    "mesh file (obj, ply, off, stl), 'default', or twin:FILE (FILE with every triangle listed twice, the copy "
+    "reversed)";
+
 /// Loads SCENE, or the embedded default scene when `path` is empty or
-/// "default"; prints a one-line load summary to stderr when `verbose`.
+/// "default", or "twin:SCENE" (kTwinPrefix); prints a one-line load summary
+/// to stderr when `verbose`.
 TriangleSoup load_scene(const std::string& path, bool allow_nonfinite, bool verbose);
 
 /// "area" or "closed" (BspMembership); throws UsageError otherwise.

@@ -100,7 +100,9 @@ void register_bench(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand(
       "bench", "benchmark modes on the same rays: speed, work, memory and error against the exact reference");
-  cmd->add_option("SCENE", args->scenes, "mesh files, 'default', or icosphere:L (generated, 20*4^L triangles)")
+  cmd->add_option("SCENE", args->scenes,
+                  "mesh files, 'default', icosphere:L (generated, 20*4^L triangles), or twin:SCENE (every "
+                  "triangle listed twice, the copy reversed)")
       ->required();
   cmd->add_option("--rays", args->rays, "ray sets: primary, random, vertex, edge, inside (icospheres only)")
       ->delimiter(',')

@@ -178,7 +178,7 @@ void run_stats(const std::string& path) {
 void register_build(CLI::App& app) {
   auto args = std::make_shared<BuildArgs>();
   CLI::App* cmd = app.add_subcommand("build", "build a tree and write it to a tree file bound to the scene");
-  cmd->add_option("SCENE", args->scene, "mesh file or 'default'")->required();
+  cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
   cmd->add_option("-o,--output", args->output, "tree file to write")->required();
   cmd->add_option("--accel", args->accel, "kd (SAH kd-tree) or bsp (exact general BSP)")->capture_default_str();
   cmd->add_option("--membership", args->membership, "bsp: area (default) or closed, see docs/bsp-build.md")

@@ -49,7 +49,7 @@ void run(const GenRaysArgs& a) {
 void register_gen_rays(CLI::App& app) {
   auto args = std::make_shared<GenRaysArgs>();
   CLI::App* cmd = app.add_subcommand("gen-rays", "write a .rays file: primary, random, vertex- or edge-aimed rays");
-  cmd->add_option("SCENE", args->scene, "mesh file or 'default'")->required();
+  cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
   cmd->add_option("-o,--output", args->output, ".rays file to write")->required();
   cmd->add_option("--kind", args->kind, "primary | random | vertex | edge")->capture_default_str();
   cmd->add_option("-n,--count", args->count, "number of rays (primary: about n pixels, square)")->capture_default_str();

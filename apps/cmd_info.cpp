@@ -29,7 +29,7 @@ void run(const InfoArgs& a) {
 void register_info(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* cmd = app.add_subcommand("info", "print triangle and vertex counts, bounds and degenerate triangles");
-  cmd->add_option("SCENE", args->scene, "mesh file or 'default'")->required();
+  cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
   cmd->callback([args] { run(*args); });
 }

@@ -146,7 +146,7 @@ void run(const RenderArgs& a) {
 void register_render(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "render a scene: ray casting, path tracing or cost heat maps");
-  cmd->add_option("SCENE", args->scene, "mesh file, or omit / 'default' for the embedded default scene");
+  cmd->add_option("SCENE", args->scene, std::string(kSceneHelp) + "; omit for the default scene");
   cmd->add_option("-o,--output", args->output, "image to write (.png, or .pfm for raw radiance)")->capture_default_str();
   cmd->add_option("--mode", args->mode, "cast (eye light, packets) | path (path tracing) | heat (cost per pixel)")
       ->capture_default_str();

@@ -224,7 +224,7 @@ void run(const TraceArgs& a) {
 void register_trace(CLI::App& app) {
   auto args = std::make_shared<TraceArgs>();
   CLI::App* cmd = app.add_subcommand("trace", "trace a .rays file and write the nearest hits to a .hits file");
-  cmd->add_option("SCENE", args->scene, "mesh file (obj, ply, off, stl) or 'default'")->required();
+  cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
   cmd->add_option("RAYS", args->rays, ".rays file (see `bsprt gen-rays`)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->hits, ".hits file to write")->required();
   add_trace_options(*cmd, args->trace, "bsp");

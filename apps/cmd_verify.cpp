@@ -90,7 +90,7 @@ void run(const VerifyArgs& a) {
 void register_verify(CLI::App& app) {
   auto args = std::make_shared<VerifyArgs>();
   CLI::App* cmd = app.add_subcommand("verify", "prove a BSP (or kd) tree file correct for a scene (exact, independent of the builder)");
-  cmd->add_option("SCENE", args->scene, "mesh file or 'default'")->required();
+  cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
   cmd->add_option("TREE", args->tree, "tree file (bsprt build --accel bsp|kd -o TREE)")->required();
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--strict", args->strict, "fail on listed triangles that do not touch the leaf's cell");

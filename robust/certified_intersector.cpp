@@ -312,6 +312,10 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     if (soup_.is_degenerate(prim)) continue;
     const std::array<Vec3f, 3> tri =
         corners ? std::array<Vec3f, 3>{corners[i].v[0], corners[i].v[1], corners[i].v[2]} : soup_.corners(prim);
+    if (detail::vertex_tie(fr, prim, std::bit_cast<std::array<float, 9>>(tri), best)) {
+      ++st.rule;
+      continue;
+    }
     const std::optional<Candidate> c = test_one(ray, fr, tri, st);
     if (!c) continue;
     bool nearer;
@@ -339,6 +343,7 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     best.on = c->on;
     best.p = c->p;
     best.q = c->q;
+    best.tri = std::bit_cast<std::array<float, 9>>(tri);
   }
   if (st.exact) fallbacks_.fetch_add(st.exact, std::memory_order_relaxed);
   if (counters) {

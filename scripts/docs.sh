@@ -55,6 +55,11 @@ VERTEX_CMD=(bench "$SCENES/stanford-bunny.obj" --rays vertex --modes "$MODES"
 INSIDE_CMD=(bench icosphere:4 icosphere:6 --rays inside,vertex --modes "$MODES" --count "$COUNT"
             --error-count "$ERROR_COUNT" -o "$PERF" --prefix inside)
 "$BSPRT" "${INSIDE_CMD[@]}" | tee "$PERF/inside.txt"
+# 3b. Every triangle listed twice, the copy with reversed winding (issue #23): each hit ties with its copy.
+TWINS_CMD=(bench "twin:$SCENES/utah-teapot.obj" "twin:$SCENES/stanford-bunny.obj" --rays primary,random,vertex,edge
+           --modes kd,kd-float,bsp,bsp-float,embree --count "$COUNT" --error-count "$ERROR_COUNT" -o "$PERF"
+           --prefix twins)
+"$BSPRT" "${TWINS_CMD[@]}" | tee "$PERF/twins.txt"
 # 4. Scaling: generated icospheres and the full dragon (the other meshes' random-ray rows come
 #    from steps 1 and 5).
 scaling_scenes=()
@@ -98,7 +103,7 @@ done
 
 # 7. docs/performance.md from the files above.
 GALLERY_LIST="${GALLERY[*]}" BENCH_CMD="bsprt ${BENCH_CMD[*]}" VERTEX_CMD="bsprt ${VERTEX_CMD[*]}" \
-  INSIDE_CMD="bsprt ${INSIDE_CMD[*]}" INTERIOR_CMD="bsprt ${INTERIOR_CMD[*]}" SMALL_CMD="bsprt ${SMALL_CMD[*]}" SCALING_CMD="bsprt ${SCALING_CMD[*]}" ELAPSED=$(($(date +%s) - start)) \
+  INSIDE_CMD="bsprt ${INSIDE_CMD[*]}" TWINS_CMD="bsprt ${TWINS_CMD[*]}" INTERIOR_CMD="bsprt ${INTERIOR_CMD[*]}" SMALL_CMD="bsprt ${SMALL_CMD[*]}" SCALING_CMD="bsprt ${SCALING_CMD[*]}" ELAPSED=$(($(date +%s) - start)) \
   SCENES="$SCENES" BUILD="$BUILD" GW="$GW" GH="$GH" SPP="$GALLERY_SPP" ERROR_COUNT="$ERROR_COUNT" \
   SCALING_LEVELS="$SCALING_LEVELS" \
   scripts/docs_write_performance.sh > docs/performance.md

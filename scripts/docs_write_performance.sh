@@ -144,6 +144,28 @@ $(summary "$PERF/inside-error-inside.md")
 
 $(summary "$PERF/inside-speed-inside.md")
 
+## Every triangle twice (copies with reversed winding)
+
+The teapot and the bunny with every triangle listed twice, the copy with reversed winding
+(\`twin:FILE\`): every hit ties with its copy at the same exact t, and the certified modes must
+report the original (the lower number) at the speed of their float modes (issue #23). The ties
+are settled by the rules of docs/exact-leaf-test.md ("Rules on exact zeros"), not by exact
+arithmetic.
+
+\`${TWINS_CMD}\`
+
+$(summary "$PERF/twins-speed-vertex.md")
+
+$(summary "$PERF/twins-speed-edge.md")
+
+$(summary "$PERF/twins-speed-primary.md")
+
+$(summary "$PERF/twins-speed-random.md")
+
+$(summary "$PERF/twins-error-vertex.md")
+
+$(summary "$PERF/twins-error-edge.md")
+
 ## Architecture seen from inside (sponza, conference)
 
 The scenes the paper's BSP is for: long, thin, slanted triangles seen from inside. Primary rays come
@@ -213,6 +235,9 @@ $(cat "$PERF/vertex-bunny.md")
 
 ### Icospheres, inside and vertex rays
 $(cat "$PERF/inside.md")
+
+### Twins (every triangle twice)
+$(cat "$PERF/twins.md")
 
 ### Sponza and conference, interior cameras
 $(cat "$PERF/interior.md")

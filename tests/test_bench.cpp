@@ -170,3 +170,44 @@ TEST_CASE("bench: per-ray-set summaries hold a row per scene and the ratios of t
   CHECK(err[2].find("| icosphere-2 |") == 0);
   CHECK(bench_error_summary(r, "no-such-set").empty());
 }
+
+// Issue #23: the scene whose triangles are all listed twice, the copy with
+// reversed winding. Every hit ties with its copy at the same exact t; the
+// certified modes must report the lower number (the original) and lose
+// nothing, and the float modes' error is measured, not assumed.
+TEST_CASE("bench: twin:SCENE lists every triangle twice, and the certified modes trace it exactly", "[bench]") {
+  const BenchScene plain = load_bench_scene("icosphere:2");
+  const BenchScene twins = load_bench_scene("twin:icosphere:2");
+  CHECK(twins.name == "icosphere-2-twins");
+  REQUIRE(twins.soup.size() == 2 * plain.soup.size());
+  REQUIRE(twins.inside_ball.has_value());
+  const std::uint32_t n = std::uint32_t(plain.soup.size());
+  for (std::uint32_t i = 0; i < n; ++i) {
+    REQUIRE(twins.soup.triangles[i] == plain.soup.triangles[i]);
+    const TriIndices& t = plain.soup.triangles[i];
+    REQUIRE(twins.soup.triangles[n + i] == TriIndices{t[0], t[2], t[1]});
+  }
+  CHECK_THROWS(load_bench_scene("twin:"));
+  BenchOptions o;
+  o.ray_sets = {"vertex", "edge", "inside"};
+  o.modes = {"exact", "bsp", "kd", "bsp-float"};
+  o.count = 1024;
+  o.error_count = 300;
+  o.threads = 2;
+  o.runs = 1;
+  const BenchResult r = run_bench({twins}, o);
+  int rows = 0;
+  for (const BenchRow& row : r.rows) {
+    if (row.mode == "bsp-float") continue;
+    ++rows;
+    CAPTURE(row.ray_set, row.mode);
+    CHECK(row.error_rays == 300);
+    CHECK(row.error.lost == 0);
+    CHECK(row.error.farther == 0);
+    CHECK(row.error.extra == 0);
+    CHECK(row.error.nearer == 0);
+    CHECK(row.error.tie == 0);  // the same triangle as the reference: the original, never its copy
+    CHECK(row.error.max_t_ulps == 0);
+  }
+  CHECK(rows == 9);
+}

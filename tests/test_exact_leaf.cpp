@@ -379,6 +379,7 @@ void require_staged_equals_intersector(const CertifiedIntersector& c, const Tria
     REQUIRE(b.t_lo == a.t_lo);
     REQUIRE(b.t_hi == a.t_hi);
     REQUIRE(b.on == a.on);
+    if (a.hit.hit()) REQUIRE(b.tri == a.tri);
     if (a.on != 0) {
       REQUIRE((b.p.x == a.p.x && b.p.y == a.p.y && b.p.z == a.p.z));
       REQUIRE((b.q.x == a.q.x && b.q.y == a.q.y && b.q.z == a.q.z));
@@ -677,6 +678,183 @@ TEST_CASE("exact leaf test: rays through axis-parallel edges, through vertices a
   const Ray r = make_ray(o, (Vec3f{2.5f, 1.5f, 0.0f} - o) * 0.5f);
   require_same(staged_nearest(ci, r, all, &foot), reference_nearest(s, r, all));
   CHECK(foot.exact_decisions > 0);
+}
+
+namespace {
+
+/// The certified intersector, counting the calls a traversal's staged test
+/// makes to it (each one a triangle the inline stages left open).
+class CountingIntersector final : public LeafIntersector {
+ public:
+  explicit CountingIntersector(const CertifiedIntersector& c) : c_(c) { staged_ = c.staged(); }
+  std::string name() const override { return "counting"; }
+  void intersect(const Ray& ray, std::span<const std::uint32_t> prims, const LeafTriangle* corners, NearestHit& best,
+                 RayCounters* counters) const override {
+    ++calls;
+    c_.intersect(ray, prims, corners, best, counters);
+  }
+  mutable int calls = 0;
+
+ private:
+  const CertifiedIntersector& c_;
+};
+
+/// detail::exact_leaf_staged over one leaf holding `prims` in this order.
+NearestHit staged_leaf(const LeafIntersector& x, const TriangleSoup& s, const Ray& r,
+                       const std::vector<std::uint32_t>& prims, RayCounters* counters = nullptr) {
+  std::vector<LeafTriangle> corners;
+  for (const std::uint32_t q : prims) corners.push_back({s.corner(q, 0), s.corner(q, 1), s.corner(q, 2)});
+  NearestHit best;
+  detail::exact_leaf_staged(x, r, detail::exact_ray_const(r), prims.data(), corners.data(),
+                            std::uint32_t(prims.size()), best, counters);
+  return best;
+}
+
+}  // namespace
+
+// Issue #23: on the teapot with every triangle listed twice (the copy with
+// reversed winding), rays aimed at vertices made the staged test call the
+// intersector about once a ray (two copies hit inside at the same t), and
+// every triangle around a vertex the ray passes through took the full double
+// stage and rule (a) to tie at that vertex.
+TEST_CASE("staged exact leaf: ties at a vertex the ray passes through, of duplicates and in an axis plane need no "
+          "intersector call",
+          "[exact][exact-leaf][regression]") {
+  // A closed fan around v (dyadic coordinates: v - o is exact for the
+  // origins below, so the rays pass exactly through v at t = 1), each
+  // triangle followed by its copy with reversed winding.
+  const Vec3f v{0.25f, 0.5f, 0.75f};
+  std::vector<std::array<Vec3f, 3>> tris;
+  std::vector<Vec3f> ring;
+  for (int k = 0; k < 6; ++k) {
+    const float a = float(k) * 1.0471976f;
+    ring.push_back({0.25f + 0.5f * std::cos(a), 0.5f + 0.5f * std::sin(a), 0.75f + 0.125f * std::cos(2 * a + 0.5f)});
+  }
+  for (int k = 0; k < 6; ++k) {
+    tris.push_back({v, ring[k], ring[(k + 1) % 6]});
+    tris.push_back({v, ring[(k + 1) % 6], ring[k]});
+  }
+  const TriangleSoup s = soup_of(tris);
+  const CertifiedIntersector c(s);
+  const CountingIntersector counting(c);
+  std::vector<std::uint32_t> order(s.size());
+  for (std::uint32_t i = 0; i < s.size(); ++i) order[i] = i;
+  std::mt19937 rng(23);
+  std::uniform_int_distribution<int> grid(-8, 8);
+  int through = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Vec3f o{float(grid(rng)), float(grid(rng)), float(grid(rng)) + 0.5f};
+    const Ray r = make_ray(o, v - o);
+    std::shuffle(order.begin(), order.end(), rng);
+    const Hit want = reference_nearest(s, r, order);
+    REQUIRE(want.hit());  // a line through v meets each triangle of the fan at v only
+    ++through;
+    RayCounters counters;
+    counting.calls = 0;
+    const NearestHit got = staged_leaf(counting, s, r, order, &counters);
+    require_same(got.hit, want);
+    CHECK(counting.calls == 0);
+    // Rule (a) for the first triangle at v, then one tie rule for each of the
+    // eleven others (the ray crosses every plane of the fan: the origins lie
+    // off all of them), not rule (a) and (b) again for each.
+    CHECK(counters.rule_decisions == 12);
+    CHECK(counters.exact_decisions == 0);
+  }
+  CHECK(through == 300);
+
+  // Rays into the inside of a triangle of the fan hit it and its copy at the
+  // same t, in a slanted plane: a tie by their corners.
+  counting.calls = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Vec3f o{float(grid(rng)), float(grid(rng)), float(grid(rng)) + 0.5f};
+    const auto& t = tris[2 * std::size_t(i % 6)];
+    const Ray r = make_ray(o, (t[0] + t[1] + t[2]) * (1.0f / 3.0f) - o);
+    std::shuffle(order.begin(), order.end(), rng);
+    const Hit want = reference_nearest(s, r, order);
+    REQUIRE(want.hit());
+    RayCounters counters;
+    require_same(staged_leaf(counting, s, r, order, &counters).hit, want);
+    CHECK(counters.rule_decisions >= 1);  // a tie of the copies (more where the ray meets an edge)
+  }
+  CHECK(counting.calls == 0);
+
+  // vertex_tie gives a new nearest hit the fields the stages give it alone.
+  for (int i = 0; i < 200; ++i) {
+    const Vec3f o{float(grid(rng)), float(grid(rng)), float(grid(rng)) + 0.5f};
+    const Ray r = make_ray(o, v - o);
+    const detail::ExactRayConst fr = detail::exact_ray_const(r);
+    for (std::uint32_t k = 0; k + 1 < s.size(); ++k) {
+      const NearestHit alone = staged_leaf(c, s, r, {k});
+      NearestHit best = staged_leaf(c, s, r, {std::uint32_t(s.size() - 1)});
+      if (!alone.hit.hit() || best.on != 1) continue;
+      const auto tri = std::bit_cast<std::array<float, 9>>(s.corners(k));
+      REQUIRE(detail::vertex_tie(fr, k, tri, best));
+      REQUIRE(best.hit.prim == k);
+      REQUIRE(std::bit_cast<std::uint32_t>(best.hit.t) == std::bit_cast<std::uint32_t>(alone.hit.t));
+      REQUIRE(std::bit_cast<std::uint32_t>(best.hit.u) == std::bit_cast<std::uint32_t>(alone.hit.u));
+      REQUIRE(std::bit_cast<std::uint32_t>(best.hit.v) == std::bit_cast<std::uint32_t>(alone.hit.v));
+      REQUIRE(best.tri == alone.tri);
+    }
+  }
+
+  // A triangle whose plane holds the ray is no tie, though it has a corner at
+  // the vertex: the reference does not count such a ray as a hit on it
+  // (every Plücker sign is 0). Triangle 0 lies in z = 0.75 with v as a
+  // corner; triangle 1 crosses the ray at v.
+  {
+    const std::vector<std::array<Vec3f, 3>> pair = {{v, Vec3f{-0.75f, 1.0f, 0.75f}, Vec3f{-0.75f, 0.0f, 0.75f}},
+                                                    {v, Vec3f{0.25f, 1.5f, 0.0f}, Vec3f{0.25f, -0.5f, 0.0f}}};
+    const TriangleSoup t = soup_of(pair);
+    const CertifiedIntersector ct(t);
+    const Ray r = make_ray({-3.75f, 0.5f, 0.75f}, Vec3f{0.25f, 0.5f, 0.75f} - Vec3f{-3.75f, 0.5f, 0.75f});
+    const Hit want = reference_nearest(t, r, {1, 0});
+    REQUIRE(want.prim == 1);
+    require_same(staged_leaf(ct, t, r, {1, 0}).hit, want);
+    NearestHit both;
+    ct.intersect(r, std::vector<std::uint32_t>{1, 0}, both, nullptr);
+    require_same(both.hit, want);
+  }
+
+  // Points in one axis plane z = 0 that the ray does not cross (it lies in
+  // it) are no tie: A (1) is hit at its corner (1, 0, 0), t = 1; B (0)
+  // touches the ray with an edge in z = 0, at t = 1 + 2^-53 or so, inside the
+  // double enclosure of A's t.
+  {
+    const std::vector<std::array<Vec3f, 3>> ab = {
+        {Vec3f{1.0f, -0x1p-30f, 0}, Vec3f{1.0f + 0x1p-23f, 1.0f, 0}, Vec3f{1.5f, 0, 1}},  // B
+        {Vec3f{1, 0, 0}, Vec3f{1, 1, 1}, Vec3f{1, -1, 1}}};                               // A
+    const TriangleSoup t = soup_of(ab);
+    const CertifiedIntersector ct(t);
+    const Ray r = make_ray({0, 0, 0}, {1, 0, 0});
+    REQUIRE(reference_t(r, t.corners(0)));
+    const Hit want = reference_nearest(t, r, {0, 1});
+    REQUIRE(want.prim == 1);
+    require_same(staged_leaf(ct, t, r, {0, 1}).hit, want);
+    require_same(staged_leaf(ct, t, r, {1, 0}).hit, want);
+  }
+
+  // Two copies hit inside, and two overlapping triangles in the plane z = c
+  // with no corner in common: ties by rule, inline.
+  {
+    const float z = 595.246f;
+    const std::vector<std::array<Vec3f, 3>> quad = {
+        {Vec3f{0, 0, z}, Vec3f{0, 1, z}, Vec3f{1, 0, z}},          // 0
+        {Vec3f{0, 0, z}, Vec3f{1, 0, z}, Vec3f{0, 1, z}},          // 1: 0 reversed
+        {Vec3f{-0.5f, -0.5f, z}, Vec3f{1.5f, -0.25f, z}, Vec3f{-0.25f, 1.5f, z}}};  // 2: overlaps 0 and 1
+    const TriangleSoup t = soup_of(quad);
+    const CertifiedIntersector ct(t);
+    const CountingIntersector cc(ct);
+    std::uniform_real_distribution<float> u(0.05f, 0.4f);
+    for (int i = 0; i < 200; ++i) {
+      const Ray r = make_ray({u(rng), u(rng), 0.0f}, {1e-4f * u(rng), 2e-4f * u(rng), 1.0f});
+      const Hit want = reference_nearest(t, r, {2, 1, 0});
+      REQUIRE(want.prim == 0);
+      RayCounters counters;
+      require_same(staged_leaf(cc, t, r, {2, 1, 0}, &counters).hit, want);
+      CHECK(counters.rule_decisions == 2);
+    }
+    CHECK(cc.calls == 0);
+  }
 }
 
 }  // namespace bsprt

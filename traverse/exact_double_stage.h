@@ -153,21 +153,33 @@ inline constexpr double kStageRel = 0x1p-48;
 /// <= 2 (E_n + |num/den|·E_d)/den. With r = fl(1/den) and q = fl(num·r),
 /// |q − num/den| <= |q|·2^-51, and the bound computed below exceeds the sum of
 /// both by the factor 1 + 2^-40, far more than its own few roundings.
-inline Stage double_t(const ExactRayConst& fr, const Ray& ray, const std::array<float, 9>& c, float& t, double& lo,
-                      double& hi) {
-  double f1[3], f2[3], a0[3];
-  const double o[3] = {ray.org.x, ray.org.y, ray.org.z};
+inline double maxabs3(const double (&v)[3]) { return std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}); }
+
+/// The face normal n = (v1 - v0) x (v2 - v0) in double, the scale mn of its
+/// error, and den = n·d with its bound eden (double_t's D and E_d): |den| >
+/// 2 eden proves that the exact n·d is not 0, i.e. that the ray crosses the
+/// triangle's plane.
+inline double double_den(const ExactRayConst& fr, const std::array<float, 9>& c, double (&n)[3], double& mn,
+                         double& eden) {
+  double f1[3], f2[3];
   for (int k = 0; k < 3; ++k) {
     f1[k] = double(c[3 + k]) - double(c[k]);
     f2[k] = double(c[6 + k]) - double(c[k]);
-    a0[k] = double(c[k]) - o[k];
   }
-  const double n[3] = {f1[1] * f2[2] - f1[2] * f2[1], f1[2] * f2[0] - f1[0] * f2[2], f1[0] * f2[1] - f1[1] * f2[0]};
-  const auto maxabs = [](const double (&v)[3]) { return std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}); };
-  const double mn = 2 * maxabs(f1) * maxabs(f2);
+  n[0] = f1[1] * f2[2] - f1[2] * f2[1], n[1] = f1[2] * f2[0] - f1[0] * f2[2], n[2] = f1[0] * f2[1] - f1[1] * f2[0];
+  mn = 2 * maxabs3(f1) * maxabs3(f2);
+  eden = 3 * kStageRel * (mn * maxabs3(fr.d));
+  return n[0] * fr.d[0] + n[1] * fr.d[1] + n[2] * fr.d[2];
+}
+
+inline Stage double_t(const ExactRayConst& fr, const Ray& ray, const std::array<float, 9>& c, float& t, double& lo,
+                      double& hi) {
+  double n[3], mn, eden;
+  double den = double_den(fr, c, n, mn, eden);
+  const double a0[3] = {double(c[0]) - double(ray.org.x), double(c[1]) - double(ray.org.y),
+                        double(c[2]) - double(ray.org.z)};
   double num = n[0] * a0[0] + n[1] * a0[1] + n[2] * a0[2];
-  double den = n[0] * fr.d[0] + n[1] * fr.d[1] + n[2] * fr.d[2];
-  const double enum_ = 3 * kStageRel * (mn * maxabs(a0)), eden = 3 * kStageRel * (mn * maxabs(fr.d));
+  const double enum_ = 3 * kStageRel * (mn * maxabs3(a0));
   if (!(std::abs(den) > 2 * eden)) return Stage::Open;
   if (den < 0) num = -num, den = -den;
   const double r = 1.0 / den, q = num * r, aq = std::abs(q);
@@ -260,6 +272,87 @@ inline bool same_place(std::uint8_t on, const Vec3f& p, const Vec3f& q, const Ne
   return false;
 }
 
+/// Whether two triangles (nine floats each) have the same three corners, in
+/// any order: coplanar duplicates (a copy with reversed winding), whose hits
+/// have the same exact t for any ray.
+inline bool same_corners(const std::array<float, 9>& a, const std::array<float, 9>& b) {
+  const auto in = [](const std::array<float, 9>& x, int i, const std::array<float, 9>& y) {
+    for (int j = 0; j < 3; ++j)
+      if (x[3 * i] == y[3 * j] && x[3 * i + 1] == y[3 * j + 1] && x[3 * i + 2] == y[3 * j + 2]) return true;
+    return false;
+  };
+  for (int i = 0; i < 3; ++i)
+    if (!in(a, i, b) || !in(b, i, a)) return false;
+  return true;
+}
+
+/// Whether two hits have the same exact t by the rules that need only float
+/// comparisons (docs/exact-leaf-test.md, "Rules on exact zeros"): the same
+/// vertex or edge (rule (b), same_place), triangles with the same corners, or
+/// hits whose known points (the vertex, the edge's ends, else the triangle's
+/// corners) all lie in one axis plane x_k = c that the ray crosses
+/// (d[k] != 0). The exact-decision intersector's same_t_by_rule checks these
+/// first, so a tie settled here is settled there the same way and counted
+/// as the same rule decision.
+inline bool same_t_by_corners(std::uint8_t on, const Vec3f& p, const Vec3f& q, const std::array<float, 9>& tri,
+                              const NearestHit& best, const Ray& ray) {
+  if (on != 0 && on == best.on && same_place(on, p, q, best)) return true;
+  if (same_corners(tri, best.tri)) return true;
+  const auto known = [](std::uint8_t at, const Vec3f& a, const Vec3f& b, const std::array<float, 9>& t,
+                        Vec3f (&out)[3]) {
+    if (at == 1) return out[0] = a, 1;
+    if (at == 2) return out[0] = a, out[1] = b, 2;
+    for (int i = 0; i < 3; ++i) out[i] = Vec3f{t[3 * i], t[3 * i + 1], t[3 * i + 2]};
+    return 3;
+  };
+  Vec3f a3[3], b3[3];
+  const int na = known(on, p, q, tri, a3), nb = known(best.on, best.p, best.q, best.tri, b3);
+  for (int k = 0; k < 3; ++k) {
+    if (ray.dir[k] == 0.0f) continue;
+    const float c = a3[0][k];
+    bool same = true;
+    for (int i = 1; i < na && same; ++i) same = a3[i][k] == c;
+    for (int i = 0; i < nb && same; ++i) same = b3[i][k] == c;
+    if (same) return true;
+  }
+  return false;
+}
+
+/// Rule (b) at a vertex, before any stage (docs/exact-leaf-test.md, "Rules
+/// on exact zeros"): when the nearest hit so far lies at a vertex (best.on ==
+/// 1, so the ray passes exactly through best.p), a triangle with a corner at
+/// that vertex whose plane the ray crosses (double_den's bound) meets the ray
+/// there and nowhere else: its exact t is the nearest hit's, and the tie goes
+/// to the smaller triangle number. Returns whether it settled the triangle; a
+/// new nearest keeps the same t, enclosure and vertex, with the barycentrics
+/// of its corner (those the stages would give it: weights 0 but one). Both the
+/// traversals' staged test and the exact-decision intersector run it first,
+/// so they keep agreeing field for field and counter for counter. Rays
+/// through a vertex meet every triangle around it, each otherwise a full
+/// double stage and rule (a).
+inline bool vertex_tie(const ExactRayConst& fr, std::uint32_t prim, const std::array<float, 9>& c, NearestHit& best) {
+  if (best.on != 1) return false;
+  int corner = -1;
+  for (int i = 0; i < 3; ++i)
+    if (c[3 * i] == best.p.x && c[3 * i + 1] == best.p.y && c[3 * i + 2] == best.p.z) corner = i;
+  if (corner < 0) return false;
+  double n[3], mn, eden;
+  const double den = double_den(fr, c, n, mn, eden);
+  if (!(std::abs(den) > 2 * eden)) return false;
+  if (prim < best.hit.prim) {
+    // The weights sum to n·d / |d[kz]| (the shear keeps triple products), so
+    // the one non-zero weight has den's sign, and the stages' u and v are
+    // w1/w and w2/w with the rule's +0 for the zero ones: 1, or a zero of
+    // den's sign.
+    const float zero = den < 0 ? -0.0f : 0.0f;
+    best.hit.prim = prim;
+    best.hit.u = corner == 1 ? 1.0f : zero;
+    best.hit.v = corner == 2 ? 1.0f : zero;
+    best.tri = c;
+  }
+  return true;
+}
+
 /// The corners of a leaf triangle as nine floats (v0, v1, v2).
 inline std::array<float, 9> corner_floats(const LeafTriangle& t) { return std::bit_cast<std::array<float, 9>>(t); }
 
@@ -312,7 +405,7 @@ template <class Fr, class TStage, class Open>
     nearer = true;
   } else if (lo > best.t_hi) {
     nearer = false;
-  } else if (on != 0 && same_place(on, p, q, best)) {  // rule (b): the same exact t
+  } else if (same_t_by_corners(on, p, q, tri, best, ray)) {  // rule (b) and its kin: the same exact t
     ++rule;
     nearer = prim < best.hit.prim;
   } else {
@@ -328,6 +421,7 @@ template <class Fr, class TStage, class Open>
   best.on = on;
   best.p = p;
   best.q = q;
+  best.tri = tri;
 }
 
 /// LeafIntersector::intersect(ray, prims[0..count), corners, best, counters),
@@ -359,6 +453,10 @@ template <class Fr, class TStage, class Open>
       continue;
     }
     const std::array<float, 9> tri = corner_floats(corners[i]);
+    if (vertex_tie(fr, prim, tri, best)) {
+      ++tests, ++rules;
+      continue;
+    }
     StageWeights sw;
     const Stage ws = double_weights(fr, tri, sw);
     const auto tstage = [&](float& t, double& lo, double& hi) { return double_t(fr, ray, tri, t, lo, hi); };

@@ -6,6 +6,7 @@
 /// enclosure of the best hit's exact t so that comparisons between hits, and
 /// the traversal's early exit, stay exact.
 
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <limits>
@@ -30,6 +31,9 @@ struct NearestHit {
   /// same exact t, which lets a tie be decided without exact arithmetic.
   std::uint8_t on = 0;
   Vec3f p, q;
+  /// The best hit's triangle (v0, v1, v2), for ties decided by the corners
+  /// alone (detail::same_t_by_corners); set with every new best hit.
+  std::array<float, 9> tri{};
 };
 
 /// The traversal's cull bound for an exact nearest hit: the smallest float at

@@ -48,4 +48,14 @@ void append(TriangleSoup& a, const TriangleSoup& b) {
   }
 }
 
+TriangleSoup with_reversed_copies(const TriangleSoup& s) {
+  if (s.triangles.size() > std::numeric_limits<std::uint32_t>::max() / 2)
+    throw UsageError("with_reversed_copies: more than 2^31-1 triangles");
+  TriangleSoup out = s;
+  out.triangles.reserve(2 * s.triangles.size());
+  for (const TriIndices& t : s.triangles) out.triangles.push_back({t[0], t[2], t[1]});
+  if (!s.degenerate.empty()) out.degenerate.insert(out.degenerate.end(), s.degenerate.begin(), s.degenerate.end());
+  return out;
+}
+
 }  // namespace bsprt

@@ -45,4 +45,10 @@ struct TriangleSoup {
 /// Appends every triangle of `b` (vertices re-indexed) to `a`.
 void append(TriangleSoup& a, const TriangleSoup& b);
 
+/// `s` with every triangle listed twice: triangle n + i is triangle i with
+/// reversed winding (corners 0, 2, 1), on the same vertices, with its flag.
+/// Coplanar duplicates that every ray meets at the same t: the scene spec
+/// "twin:FILE" (docs/exact-leaf-test.md, "Rules on exact zeros").
+TriangleSoup with_reversed_copies(const TriangleSoup& s);
+
 }  // namespace bsprt

@@ -265,6 +265,7 @@ inline unsigned packet_exact_triangle(const LeafIntersector& x, const PacketExac
     const double before = best.t_hi;
     const auto open = [&] { x.intersect(rays[lane], std::span<const std::uint32_t>(prim, 1), &t, best, nullptr); };
     const auto fr = [&]() -> const detail::ExactRayConst& { return er[lane].get(rays[lane]); };
+    if (best.on == 1 && detail::vertex_tie(fr(), *prim, tri, best)) continue;
     packet_staged_lane<W>(out, lane, fr, rays[lane], *prim, tri, open, best);
     if (!(best.t_hi == before)) changed |= 1u << lane;
   }
