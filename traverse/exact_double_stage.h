@@ -147,6 +147,9 @@ inline constexpr double kStageRel = 0x1p-48;
 /// rounds beyond the float range (docs/exact-leaf-test.md, "Hits beyond the
 /// float range"). Open: the exact stage must round t.
 ///
+/// double_t_range is the part before the rounding: its Hit says only that
+/// the exact t lies in [tnear, tfar] (enclosed by [l, h]).
+///
 /// One division (docs/exact-leaf-test.md, "The double filter"): with num and
 /// den computed within E_n and E_d of the exact N and D, and den > 2 E_d after
 /// the sign flip, |N/D − num/den| <= (E_n + |num/den|·E_d)/(den − E_d)
@@ -172,8 +175,8 @@ inline double double_den(const ExactRayConst& fr, const std::array<float, 9>& c,
   return n[0] * fr.d[0] + n[1] * fr.d[1] + n[2] * fr.d[2];
 }
 
-inline Stage double_t(const ExactRayConst& fr, const Ray& ray, const std::array<float, 9>& c, float& t, double& lo,
-                      double& hi) {
+inline Stage double_t_range(const ExactRayConst& fr, const Ray& ray, const std::array<float, 9>& c, double& l,
+                            double& h) {
   double n[3], mn, eden;
   double den = double_den(fr, c, n, mn, eden);
   const double a0[3] = {double(c[0]) - double(ray.org.x), double(c[1]) - double(ray.org.y),
@@ -184,12 +187,20 @@ inline Stage double_t(const ExactRayConst& fr, const Ray& ray, const std::array<
   if (den < 0) num = -num, den = -den;
   const double r = 1.0 / den, q = num * r, aq = std::abs(q);
   const double b = ((enum_ + aq * eden) * r) * (2 + 0x1p-39) + aq * 0x1p-51;
-  double l = q - b, h = q + b;
+  l = q - b, h = q + b;
   l -= std::abs(l) * 0x1p-51;  // the rounding of q ± b
   h += std::abs(h) * 0x1p-51;
   const double tnear = ray.tnear, tfar = ray.tfar;
   if (h < tnear || l > tfar) return Stage::Miss;
   if (!(l >= tnear && h <= tfar)) return Stage::Open;
+  return Stage::Hit;
+}
+
+inline Stage double_t(const ExactRayConst& fr, const Ray& ray, const std::array<float, 9>& c, float& t, double& lo,
+                      double& hi) {
+  double l, h;
+  const Stage range = double_t_range(fr, ray, c, l, h);
+  if (range != Stage::Hit) return range;
   const float fl = float(l), fh = float(h);
   if (fl != fh) return Stage::Open;
   if (std::isinf(fl)) return Stage::Miss;  // beyond the float range
@@ -365,7 +376,7 @@ inline std::array<float, 9> corner_floats(const LeafTriangle& t) { return std::b
 /// before anything about the triangle is counted. The caller has checked
 /// that prim is not the nearest hit already. `fr()` gives the ray's
 /// ExactRayConst (rule (a) needs it; a packet kernel makes it on demand).
-template <class Fr, class TStage, class Open>
+template <bool kAnyHit = false, class Fr, class TStage, class Open>
 [[gnu::always_inline]] inline void staged_decide(Fr&& fr, const Ray& ray, std::uint32_t prim,
                                                  const std::array<float, 9>& tri, Stage ws, StageWeights& sw,
                                                  TStage&& tstage, Open&& open, NearestHit& best,
@@ -388,7 +399,12 @@ template <class Fr, class TStage, class Open>
   }
   float t;
   double lo, hi;
-  const Stage ts = tstage(t, lo, hi);
+  Stage ts = tstage(t, lo, hi);
+  // Any hit (occluded): a t certainly in [tnear, tfar] will do, rounded or
+  // not; only a hit whose enclosure reaches past the float range stays open.
+  if constexpr (kAnyHit)
+    if (ts == Stage::Open && double_t_range(fr(), ray, tri, lo, hi) == Stage::Hit && std::isfinite(float(hi)))
+      ts = Stage::Hit, t = float(hi);
   if (ts == Stage::Miss) {
     ++tests, rules += rule;
     return;
@@ -436,7 +452,10 @@ template <class Fr, class TStage, class Open>
 /// these functions first, in the same order) and keeps the nearest by the
 /// same comparisons, so the answer, the enclosure and the counters are its
 /// own. `ray` must be valid. `fr` = exact_ray_const(ray), made once per ray by
-/// the caller.
+/// the caller. kAnyHit (occluded): a hit certainly in [tnear, tfar] is taken
+/// without rounding its t (staged_decide), so `best` then holds some hit, not
+/// necessarily with the nearest float t; only whether there is one counts.
+template <bool kAnyHit = false>
 [[gnu::always_inline]] inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
                                                      const std::uint32_t* prims, const LeafTriangle* corners,
                                                      std::uint32_t count, NearestHit& best, RayCounters* c) {
@@ -460,8 +479,8 @@ template <class Fr, class TStage, class Open>
     StageWeights sw;
     const Stage ws = double_weights(fr, tri, sw);
     const auto tstage = [&](float& t, double& lo, double& hi) { return double_t(fr, ray, tri, t, lo, hi); };
-    staged_decide([&]() -> const ExactRayConst& { return fr; }, ray, prim, tri, ws, sw, tstage, open, best, tests,
-                  rules);
+    staged_decide<kAnyHit>([&]() -> const ExactRayConst& { return fr; }, ray, prim, tri, ws, sw, tstage, open, best,
+                           tests, rules);
   }
   if (c) c->triangle_tests += tests, c->rule_decisions += rules;
 }

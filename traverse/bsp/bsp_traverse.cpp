@@ -49,14 +49,14 @@ inline void leaf_ray_setup(const BspView& v, const Ray& ray, LeafRay& lr) {
 /// Tests the triangles of a leaf (ties keep the earlier triangle). With an
 /// exact leaf test, `nearest` keeps the exact order and the answer; hit then
 /// holds its prim and, as t, the cull bound (cull_bound).
-template <bool kCount>
+template <bool kCount, bool kAnyHit = false>
 inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray& ray, const LeafRay& lr,
                            Hit& hit, NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if constexpr (kCount) ++c->leaf_visits;
   if (v.exact_leaf) {
-    detail::exact_leaf_staged(*v.exact_leaf, ray, lr.er, v.prims + first, v.triangles + first, n.prim_count(),
-                              nearest, kCount ? c : nullptr);
+    detail::exact_leaf_staged<kAnyHit>(*v.exact_leaf, ray, lr.er, v.prims + first, v.triangles + first,
+                                       n.prim_count(), nearest, kCount ? c : nullptr);
     hit.prim = nearest.hit.prim;
     hit.t = cull_bound(nearest);
     return;
@@ -137,7 +137,7 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       n = &v.nodes[node];
     }
     if (leaf) {
-      intersect_leaf<kCount>(v, *n, ray, lr, hit, nearest, c);
+      intersect_leaf<kCount, kAnyHit>(v, *n, ray, lr, hit, nearest, c);
       if constexpr (kAnyHit) {  // occluded: the first leaf with a hit ends the walk
         if (v.exact_leaf ? nearest.hit.hit() : hit.hit()) return;
       }

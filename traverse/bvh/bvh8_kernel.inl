@@ -300,8 +300,8 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
         const unsigned lanes =
             filter ? exact_lanes(wr, v.leaf_soa + 9 * std::size_t(first), count) : (1u << count) - 1u;
         if (lanes == (1u << count) - 1u) {
-          exact_leaf_staged(*v.exact_leaf, ray, er.get(ray), v.prims + first, v.triangles + first, count, nearest,
-                            kCount ? c : nullptr);
+          exact_leaf_staged<kAnyHit>(*v.exact_leaf, ray, er.get(ray), v.prims + first, v.triangles + first, count,
+                                     nearest, kCount ? c : nullptr);
         } else if (lanes != 0) {
           std::uint32_t p[4];
           LeafTriangle t[4];
@@ -311,7 +311,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
             p[n] = v.prims[first + i];
             t[n] = v.triangles[first + i];
           }
-          exact_leaf_staged(*v.exact_leaf, ray, er.get(ray), p, t, n, nearest, kCount ? c : nullptr);
+          exact_leaf_staged<kAnyHit>(*v.exact_leaf, ray, er.get(ray), p, t, n, nearest, kCount ? c : nullptr);
         }
         if constexpr (kCount) c->triangle_tests += count - std::uint32_t(__builtin_popcount(lanes));
         if (kAnyHit && nearest.hit.hit()) return nearest.hit;

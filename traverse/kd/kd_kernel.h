@@ -63,6 +63,7 @@ inline namespace BSPRT_ISA_NAMESPACE {  // compiled into per-ISA kernels too (si
 /// Gathering rows and corners into stack buffers first, float by float, made
 /// every vector read of them a store-forwarding stall (perf, conference camera
 /// rays: the hottest instructions of these leaves).
+template <bool kAnyHit = false>
 inline void kd_exact_leaf(const KdView& v, std::uint32_t first, std::uint32_t end, const Ray& ray,
                           const WatertightRay& wr, bool filter, LazyExactRay& er, NearestHit& nearest,
                           RayCounters* c) {
@@ -77,7 +78,7 @@ inline void kd_exact_leaf(const KdView& v, std::uint32_t first, std::uint32_t en
     }
     for (unsigned bits = lanes; bits != 0; bits &= bits - 1) {
       const std::uint32_t prim = v.prims[i + std::uint32_t(__builtin_ctz(bits))];
-      exact_leaf_staged(*v.exact_leaf, ray, er.get(ray), &prim, &v.triangles[prim], 1, nearest, c);
+      exact_leaf_staged<kAnyHit>(*v.exact_leaf, ray, er.get(ray), &prim, &v.triangles[prim], 1, nearest, c);
     }
   }
 }

@@ -42,7 +42,7 @@ inline void clip_root(const Box3f& b, const float o[3], const float inv[3], cons
 /// Tests the triangles of a leaf. With an exact leaf test, `nearest` keeps the
 /// exact order and the answer; hit then holds its prim and, as t, the cull
 /// bound (cull_bound).
-template <bool kCount>
+template <bool kCount, bool kAnyHit = false>
 inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, const WatertightRay& wr, bool filter,
                            Hit& hit, detail::LazyExactRay& er, NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
@@ -51,7 +51,7 @@ inline void intersect_leaf(const KdView& v, const KdNode& n, const Ray& ray, con
     // An empty leaf (most leaves a ray visits in the shared scenes) leaves
     // `nearest`, and so `hit`, as they are: no call.
     if (first == end) return;
-    detail::kd_exact_leaf(v, first, end, ray, wr, filter, er, nearest, kCount ? c : nullptr);
+    detail::kd_exact_leaf<kAnyHit>(v, first, end, ray, wr, filter, er, nearest, kCount ? c : nullptr);
     hit.prim = nearest.hit.prim;
     hit.t = cull_bound(nearest);
     return;
@@ -111,7 +111,7 @@ Hit trace_from(const KdView& v, const Ray& ray, const WatertightRay& wr, bool fi
       n = &v.nodes[node];
     }
     if (n->is_leaf()) {
-      intersect_leaf<kCount>(v, *n, ray, wr, filter, hit, er, nearest, c);
+      intersect_leaf<kCount, kAnyHit>(v, *n, ray, wr, filter, hit, er, nearest, c);
       if constexpr (kAnyHit) {
         if (v.exact_leaf ? nearest.hit.hit() : hit.hit()) return v.exact_leaf ? nearest.hit : hit;
       }
