@@ -129,7 +129,17 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       const bool first_empty = (head & CompactBspSlot::kFirstEmpty) != 0;
       const bool second_empty = (head & CompactBspSlot::kSecondEmpty) != 0;
       const bool near_empty = flip ? second_empty : first_empty, far_empty = flip ? first_empty : second_empty;
-      const bool go_near = !(near_hi < tmin) && !near_empty, go_far = !(far_lo > tmax) && !far_empty;  // NaN: both
+      // NaN: both. Any-hit walks (shadow rays from scattered surface points)
+      // combine the tests without branches: on 50K sponza shadow rays that
+      // took 13 mispredicts a ray off (cachegrind) and 5 % of the time, while
+      // coherent camera rays ran 3 % slower that way (docs/notes/
+      // 2026-12-06-vertex-ties-and-shadow-rays.md).
+      bool go_near, go_far;
+      if constexpr (kAnyHit) {
+        go_near = !(near_hi < tmin) & !near_empty, go_far = !(far_lo > tmax) & !far_empty;
+      } else {
+        go_near = !(near_hi < tmin) && !near_empty, go_far = !(far_lo > tmax) && !far_empty;
+      }
       if (!detail::step_near_far(near, far, go_near, go_far, near_hi, far_lo, node, tmin, tmax, stack, sp)) {
         leaf = false;
         break;
