@@ -102,11 +102,14 @@ struct Stages {
 /// origin moves to o + (e, e^2, e^3) for an infinitesimal e > 0. The weight
 /// pairing p and q (in this order) becomes w - delta.((q - p) x d), so its sign
 /// is minus the sign of the first non-zero component of (q - p) x d; 0 when q - p
-/// is parallel to d (the ray is then parallel to the triangle's plane).
+/// is parallel to d (the ray is then parallel to the triangle's plane). Each
+/// component is a sum of four products of floats (cross_terms), signed
+/// exactly without the heap (exact_sum.h).
 int sos_sign(const Vec3f& p, const Vec3f& q, const Vec3f& dir) {
-  const M3 c = mcross(msub(q, p), mvec(dir));
-  for (const Mp* x : {&c.x, &c.y, &c.z})
-    if (const int s = msign(*x); s != 0) return -s;
+  for (int j = 0; j < 3; ++j) {
+    double approx;
+    if (const int s = detail::exact_sum_sign(detail::cross_terms(q, p, dir, j), approx); s != 0) return -s;
+  }
   return 0;
 }
 
@@ -179,7 +182,7 @@ std::optional<Candidate> test_one(const Ray& ray, const ExactRayConst& fr, const
   }
   if (sos && (s[0] == 0 || s[1] == 0 || s[2] == 0)) {
     if (s[0] == 0 && s[1] == 0 && s[2] == 0) return std::nullopt;  // the ray lies in the plane
-    ++st.exact;
+    ++st.rule;  // exact signs of float products, no exact stage
     for (int k = 0; k < 3; ++k)
       if (s[k] == 0) s[k] = sos_sign(tri[(k + 1) % 3], tri[(k + 2) % 3], ray.dir);
   }
