@@ -123,12 +123,16 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
       }
       const std::uint32_t second = head >> CompactBspSlot::kShift;
       const std::uint32_t near = flip ? second : first, far = flip ? first : second;
-      // Empty children, selected like near and far (fixed masks, then
-      // selects) rather than shifted by flip: a variable shift count costs
-      // moves into cl on the base ISA.
-      const bool first_empty = (head & CompactBspSlot::kFirstEmpty) != 0;
-      const bool second_empty = (head & CompactBspSlot::kSecondEmpty) != 0;
-      const bool near_empty = flip ? second_empty : first_empty, far_empty = flip ? first_empty : second_empty;
+      // Empty children: the near and far child's bit masks are selected like
+      // near and far, then tested against head. The compiler splits the step
+      // by flip, so each test is one test-and-branch on a constant mask. Not
+      // shifted by flip (a variable shift count costs moves into cl on the
+      // base ISA), and not bools extracted from head first (six instructions
+      // a step, 3-5 % slower on sponza and conference camera rays;
+      // docs/notes/2026-12-06-vertex-ties-and-shadow-rays.md).
+      const std::uint32_t near_bit = flip ? CompactBspSlot::kSecondEmpty : CompactBspSlot::kFirstEmpty;
+      const std::uint32_t far_bit = flip ? CompactBspSlot::kFirstEmpty : CompactBspSlot::kSecondEmpty;
+      const bool near_empty = (head & near_bit) != 0, far_empty = (head & far_bit) != 0;
       // NaN: both. Any-hit walks (shadow rays from scattered surface points)
       // combine the tests without branches: on 50K sponza shadow rays that
       // took 13 mispredicts a ray off (cachegrind) and 5 % of the time, while
