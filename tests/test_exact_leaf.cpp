@@ -716,29 +716,22 @@ TEST_CASE("exact leaf test: any hit takes a t in range without rounding it, near
     }
   }
   // A t that rounds past the float range is a miss for any hit too: the
-  // plane z = 2^30 with d = (0, 0, 2^-100) gives t = 2^130 > FLT_MAX.
-  const std::vector<std::array<Vec3f, 3>> high = {
-      {Vec3f{-1, -1, 0x1p30f}, Vec3f{3, -1, 0x1p30f}, Vec3f{-1, 3, 0x1p30f}}};
-  const TriangleSoup sh = soup_of(high);
-  const CertifiedIntersector ch(sh);
-  const LeafTriangle lh{high[0][0], high[0][1], high[0][2]};
-  const Ray far = make_ray({0, 0, 0}, {0, 0, 0x1p-100f});
-  REQUIRE(!reference_nearest(sh, far, prims).hit());
-  NearestHit best;
-  detail::exact_leaf_staged<true>(ch, far, detail::exact_ray_const(far), prims.data(), &lh, 1, best, nullptr);
-  CHECK(!best.hit.hit());
+  // any-hit test of one ray against a triangle in the plane z = h.
+  const auto any_hit_at = [&](float h, const Ray& r) {
+    const std::vector<std::array<Vec3f, 3>> one = {{Vec3f{-1, -1, h}, Vec3f{3, -1, h}, Vec3f{-1, 3, h}}};
+    const TriangleSoup so = soup_of(one);
+    const CertifiedIntersector co(so);
+    const LeafTriangle lo{one[0][0], one[0][1], one[0][2]};
+    REQUIRE(!reference_nearest(so, r, prims).hit());
+    NearestHit b;
+    detail::exact_leaf_staged<true>(co, r, detail::exact_ray_const(r), prims.data(), &lo, 1, b, nullptr);
+    return b.hit.hit();
+  };
+  // z = 2^30 with d = (0, 0, 2^-100): t = 2^130 > FLT_MAX.
+  CHECK(!any_hit_at(0x1p30f, make_ray({0, 0, 0}, {0, 0, 0x1p-100f})));
   // t = (2^25 - 1) 2^103 = FLT_MAX + half an ulp exactly, which rounds to
   // +inf: the enclosure straddles the top of the float range and stays open.
-  const std::vector<std::array<Vec3f, 3>> top = {
-      {Vec3f{-1, -1, 0x1p25f}, Vec3f{3, -1, 0x1p25f}, Vec3f{-1, 3, 0x1p25f}}};
-  const TriangleSoup st = soup_of(top);
-  const CertifiedIntersector ct(st);
-  const LeafTriangle lt{top[0][0], top[0][1], top[0][2]};
-  const Ray edge = make_ray({0, 0, 1}, {0, 0, 0x1p-103f});
-  REQUIRE(!reference_nearest(st, edge, prims).hit());
-  NearestHit at_top;
-  detail::exact_leaf_staged<true>(ct, edge, detail::exact_ray_const(edge), prims.data(), &lt, 1, at_top, nullptr);
-  CHECK(!at_top.hit.hit());
+  CHECK(!any_hit_at(0x1p25f, make_ray({0, 0, 1}, {0, 0, 0x1p-103f})));
 }
 
 namespace {
