@@ -76,6 +76,7 @@ void run_path(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup
   PathOptions options;
   options.width = base.width, options.height = base.height, options.camera = base.camera;
   options.spp = a.spp, options.bounces = a.bounces, options.seed = a.seed, options.packet_width = base.packet_width;
+  options.count = a.stats;
   PathStats stats;
   Image image;
   {
@@ -89,15 +90,25 @@ void run_path(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup
              a.output);
   std::string json = fmt::format("{{\"accel\": \"{}\", \"mode\": \"path\", \"width\": {}, \"height\": {}, \"spp\": {}, "
                                  "\"bounces\": {}, \"seed\": {}, \"seconds\": {:.6f}, \"rays\": {}, \"nan_pixels\": {}, "
-                                 "\"by_bounce\": [",
+                                 "\"counted\": {}, \"by_bounce\": [",
                                  tracer.name(), options.width, options.height, options.spp, options.bounces,
-                                 options.seed, stats.seconds, stats.rays, stats.nan_pixels);
+                                 options.seed, stats.seconds, stats.rays, stats.nan_pixels, a.stats);
   for (std::size_t b = 0; b < stats.rays_by_bounce.size(); ++b) {
     const double s = stats.trace_seconds_by_bounce[b];
     const double mrays = s > 0 ? stats.rays_by_bounce[b] / s * 1e-6 : 0.0;
     fmt::print("  bounce {}: {} rays, {:.2f} Mrays/s per thread\n", b, stats.rays_by_bounce[b], mrays);
-    json += fmt::format("{}{{\"bounce\": {}, \"rays\": {}, \"trace_thread_seconds\": {:.6f}, \"mrays_per_thread_second\": {:.4f}}}",
+    json += fmt::format("{}{{\"bounce\": {}, \"rays\": {}, \"trace_thread_seconds\": {:.6f}, \"mrays_per_thread_second\": {:.4f}",
                         b ? ", " : "", b, stats.rays_by_bounce[b], s, mrays);
+    if (a.stats) {  // work per ray of this bounce (path and shadow rays); the timing above includes the counting
+      const RayCounters& c = stats.counters_by_bounce[b];
+      const double n = stats.rays_by_bounce[b] ? double(stats.rays_by_bounce[b]) : 1.0;
+      fmt::print("    per ray: {:.3f} kd node visits, {:.3f} BSP node visits, {:.3f} leaf visits, {:.3f} triangle tests\n",
+                 c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n);
+      json += fmt::format(", \"kd_node_visits\": {:.4f}, \"bsp_node_visits\": {:.4f}, \"leaf_visits\": {:.4f}, "
+                          "\"triangle_tests\": {:.4f}",
+                          c.kd_node_visits / n, c.bsp_node_visits / n, c.leaf_visits / n, c.triangle_tests / n);
+    }
+    json += "}";
   }
   json += "]}\n";
   if (!a.json.empty()) std::ofstream(a.json) << json;
@@ -158,7 +169,8 @@ void register_render(CLI::App& app) {
   cmd->add_option("--camera", args->camera,
                   "camera file (docs/rendering.md), FILE or FILE:NAME, e.g. bench/cameras.json:sponza-atrium; "
                   "--vp/--vi/--vu/--fov override its fields");
-  cmd->add_flag("--stats", args->stats, "cast: count and print node visits and triangle tests per ray");
+  cmd->add_flag("--stats", args->stats, "cast: count and print node visits and triangle tests per ray; path: the same per bounce, also "
+                "in --json (the timings then include the counting)");
   cmd->add_option("--spp", args->spp, "path: samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--bounces", args->bounces, "path: indirect bounces (0 = direct light)")->capture_default_str()
       ->check(CLI::Range(0, 64));

@@ -77,6 +77,9 @@ struct PathState {
 struct ThreadStats {
   std::vector<std::uint64_t> rays;
   std::vector<double> seconds;
+  std::vector<RayCounters> counters;  ///< per bounce, when counting
+  bool count = false;
+  RayCounters* counters_of(int bounce) { return count ? &counters[std::size_t(bounce)] : nullptr; }
 };
 
 /// Traces `rays` into `hits` and books the time and count under `bounce`.
@@ -84,7 +87,7 @@ void trace_timed(const Accelerator& tracer, const std::vector<Ray>& rays, std::v
                  ThreadStats& ts, int bounce) {
   hits.resize(rays.size());
   const auto t0 = std::chrono::steady_clock::now();
-  tracer.trace_batch(rays, hits, packet, nullptr);
+  tracer.trace_batch(rays, hits, packet, ts.counters_of(bounce));
   ts.seconds[bounce] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ts.rays[bounce] += rays.size();
 }
@@ -95,7 +98,8 @@ void occluded_timed(const Accelerator& tracer, const std::vector<Ray>& rays, std
                     ThreadStats& ts, int bounce) {
   blocked.resize(rays.size());
   const auto t0 = std::chrono::steady_clock::now();
-  for (std::size_t i = 0; i < rays.size(); ++i) blocked[i] = tracer.occluded(rays[i]) ? 1 : 0;
+  RayCounters* const c = ts.counters_of(bounce);
+  for (std::size_t i = 0; i < rays.size(); ++i) blocked[i] = tracer.occluded(rays[i], c) ? 1 : 0;
   ts.seconds[bounce] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ts.rays[bounce] += rays.size();
 }
@@ -224,7 +228,10 @@ Image render_path(const Accelerator& tracer, const TriangleSoup& soup, const Pat
   const std::uint64_t total = std::uint64_t(tiles_x) * std::uint64_t(tiles_y);
   std::atomic<std::uint64_t> done{0}, nan_pixels{0};
   const std::size_t depth = std::size_t(options.bounces) + 1;
-  tbb::combinable<ThreadStats> per_thread([&] { return ThreadStats{std::vector<std::uint64_t>(depth, 0), std::vector<double>(depth, 0.0)}; });
+  tbb::combinable<ThreadStats> per_thread([&] {
+    return ThreadStats{std::vector<std::uint64_t>(depth, 0), std::vector<double>(depth, 0.0),
+                       std::vector<RayCounters>(depth), options.count};
+  });
   tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, total, 1), [&](const auto& range) {
     for (std::uint64_t t = range.begin(); t < range.end(); ++t) {
       const int x0 = int(t % std::uint64_t(tiles_x)) * kTile, y0 = int(t / std::uint64_t(tiles_x)) * kTile;
@@ -240,10 +247,12 @@ Image render_path(const Accelerator& tracer, const TriangleSoup& soup, const Pat
     *stats = {};
     stats->rays_by_bounce.assign(depth, 0);
     stats->trace_seconds_by_bounce.assign(depth, 0.0);
+    stats->counters_by_bounce.assign(depth, RayCounters{});
     per_thread.combine_each([&](const ThreadStats& ts) {
       for (std::size_t b = 0; b < depth; ++b) {
         stats->rays_by_bounce[b] += ts.rays[b];
         stats->trace_seconds_by_bounce[b] += ts.seconds[b];
+        stats->counters_by_bounce[b] += ts.counters[b];
       }
     });
     for (std::uint64_t r : stats->rays_by_bounce) stats->rays += r;

@@ -16,6 +16,7 @@
 #include "geometry/scenes/camera.h"
 #include "geometry/core/triangle_soup.h"
 #include "traverse/accelerator.h"
+#include "traverse/counters.h"
 
 namespace bsprt {
 
@@ -29,6 +30,7 @@ struct PathOptions {
   std::uint64_t seed = 1;     ///< random seed (--seed)
   float albedo = 0.7f;        ///< diffuse reflectance of every surface
   int packet_width = 1;       ///< packets for camera rays (--packets); later bounces use single rays
+  bool count = false;         ///< count node visits and triangle tests per bounce (--stats; slows the timed trace)
 };
 
 /// Figures of a path-traced render.
@@ -36,6 +38,7 @@ struct PathStats {
   std::uint64_t rays = 0;                      ///< all rays: camera, bounce and shadow rays
   std::vector<std::uint64_t> rays_by_bounce;   ///< [0] camera rays, [k] rays of bounce k (incl. shadow rays)
   std::vector<double> trace_seconds_by_bounce; ///< summed tracing time over threads, per bounce
+  std::vector<RayCounters> counters_by_bounce; ///< work per bounce (PathOptions::count; else all zero)
   std::uint64_t nan_pixels = 0;                ///< pixels whose estimate was not finite (reported, set to 0)
   double seconds = 0.0;                        ///< wall time
 };

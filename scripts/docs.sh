@@ -93,6 +93,10 @@ for m in "${GALLERY[@]}"; do
     "$BSPRT" build "$SCENES/$m" --accel "$a" -o "$PERF/$s.$a.tree" >/dev/null
     "$BSPRT" render "$SCENES/$m" "${cam[@]}" --accel "$a" --tree "$PERF/$s.$a.tree" --mode path --size "$GW" "$GH" \
       --spp "$GALLERY_SPP" -o "$GAL/$s-path-$a.png" --json "$PERF/$s-path-$a.json" >/dev/null
+    # Work per ray by bounce, counted on a smaller render of the same view (counting slows the timed trace).
+    "$BSPRT" render "$SCENES/$m" "${cam[@]}" --accel "$a" --tree "$PERF/$s.$a.tree" --mode path --size 160 120 \
+      --spp 4 --stats -o "$PERF/$s-path-$a-counts.png" --json "$PERF/$s-path-$a-counts.json" >/dev/null
+    rm -f "$PERF/$s-path-$a-counts.png"
     "$BSPRT" render "$SCENES/$m" "${cam[@]}" --accel "$a" --tree "$PERF/$s.$a.tree" --mode heat --heat-metric tests \
       --size "$GW" "$GH" -o "$GAL/$s-heat-tests-$a.png" >/dev/null
   done

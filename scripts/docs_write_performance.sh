@@ -11,16 +11,25 @@ GAL=docs/gallery
 summary() { if [ -s "$1" ]; then cat "$1"; else echo "(no rows: $(basename "$1") was not written)"; fi; }
 
 # path_table: Mrays/s per thread and bounce of kd, bsp, embree for each gallery scene.
+# Work per ray (node visits kd + BSP, triangle tests) comes from the counted renders
+# (PREFIX-counts.json: 160x120, 4 spp, the same view).
 path_table() {
-  echo "| scene | bounce | rays | kd | bsp | embree | **bsp / kd** | **bsp / embree** |"
-  echo "|---|---:|---:|---:|---:|---:|---:|---:|"
+  echo "| scene | bounce | rays | kd | bsp | embree | **bsp / kd** | **bsp / embree** | node visits / ray kd → bsp (kd + BSP) | triangle tests / ray kd → bsp |"
+  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
   for m in $GALLERY_LIST; do
     s="${m%.*}"
-    for a in kd bsp embree; do
-      tr '{' '\n' < "$PERF/$s-path-$a.json" | awk -F'[:,]' -v a="$a" '/"bounce"/ { print a, $2 + 0, $4 + 0, $8 + 0 }'
-    done | awk -v sc="$s" '
-      { m[$1, $2] = $4; r[$2] = $3; if ($2 > nb) nb = $2 }
-      END { for (b = 0; b <= nb; ++b) printf "| %s | %d | %d | %.2f | %.2f | %.2f | %.2f | %.2f |\n", sc, b, r[b], m["kd", b], m["bsp", b], m["embree", b], m["bsp", b] / m["kd", b], m["bsp", b] / m["embree", b] }'
+    {
+      for a in kd bsp embree; do
+        tr '{' '\n' < "$PERF/$s-path-$a.json" | awk -F'[:,]' -v a="$a" '/"bounce"/ { print "t", a, $2 + 0, $4 + 0, $8 + 0 }'
+      done
+      for a in kd bsp; do
+        tr '{' '\n' < "$PERF/$s-path-$a-counts.json" |
+          awk -F'[:,]' -v a="$a" '/"bounce"/ { print "c", a, $2 + 0, $10 + 0, $12 + 0, $16 + 0 }'
+      done
+    } | awk -v sc="$s" '
+      $1 == "t" { m[$2, $3] = $5; r[$3] = $4; if ($3 > nb) nb = $3 }
+      $1 == "c" { kdv[$2, $3] = $4; bspv[$2, $3] = $5; tests[$2, $3] = $6 }
+      END { for (b = 0; b <= nb; ++b) printf "| %s | %d | %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f → %.1f + %.1f | %.2f → %.2f |\n", sc, b, r[b], m["kd", b], m["bsp", b], m["embree", b], m["bsp", b] / m["kd", b], m["bsp", b] / m["embree", b], kdv["kd", b], kdv["bsp", b], bspv["bsp", b], tests["kd", b], tests["bsp", b] }'
   done
 }
 
@@ -204,7 +213,9 @@ $(awk -F, 'NR == 1 { print "| scene | triangles | mode | build s | Mrays/s | MB 
 
 \`bsprt render SCENE --mode path --accel kd|bsp|embree --size ${GW} ${GH} --spp ${SPP} --json …\` (3 bounces,
 next-event estimation; bounce 0 = camera rays, k = rays of bounce k including shadow rays; single
-rays after the camera; Mrays/s per thread-second of tracing).
+rays after the camera; Mrays/s per thread-second of tracing). Node visits and triangle tests per ray
+of each bounce (path and shadow rays) come from \`bsprt render … --mode path --size 160 120 --spp 4
+--stats --json …\` on the same view and trees: counting slows the timed trace, so it runs apart.
 
 $(path_table)
 

@@ -6,6 +6,7 @@
 #include <tbb/global_control.h>
 
 #include <random>
+#include <string>
 
 #include "apps/heat_map.h"
 #include "apps/path_tracer.h"
@@ -70,6 +71,47 @@ TEST_CASE("path tracing: no NaN, deterministic across thread counts", "[render]"
     sum += v;
   }
   CHECK(sum / double(one.rgb.size()) > 0.02);  // lit, not black
+}
+
+// Issue #24 asks for the work per ray by bounce beside Mrays/s:
+// `bsprt render --mode path --stats`.
+TEST_CASE("path tracing: counting gives each bounce's work, the same for any thread count, and the same image",
+          "[render]") {
+  const TriangleSoup scene = make_default_scene();
+  for (const char* mode : {"bsp", "kd"}) {
+    CAPTURE(mode);
+    const auto t = make_tracer(mode, scene);
+    PathOptions counted = small_path();
+    counted.count = true;
+    PathStats plain_stats, one_stats, two_stats;
+    const Image plain = render_path(*t, scene, small_path(), &plain_stats);
+    Image one, two;
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+      one = render_path(*t, scene, counted, &one_stats);
+    }
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+      two = render_path(*t, scene, counted, &two_stats);
+    }
+    CHECK(plain.rgb == one.rgb);
+    CHECK(one.rgb == two.rgb);
+    REQUIRE(one_stats.counters_by_bounce.size() == 3);
+    for (std::size_t b = 0; b < 3; ++b) {
+      CAPTURE(b);
+      const RayCounters &c1 = one_stats.counters_by_bounce[b], &c2 = two_stats.counters_by_bounce[b];
+      CHECK(plain_stats.counters_by_bounce[b].rays == 0);  // not counted unless asked
+      CHECK(c1.rays == one_stats.rays_by_bounce[b]);       // every path and shadow ray of the bounce
+      CHECK(c1.rays == c2.rays);
+      CHECK(c1.kd_node_visits == c2.kd_node_visits);
+      CHECK(c1.bsp_node_visits == c2.bsp_node_visits);
+      CHECK(c1.leaf_visits == c2.leaf_visits);
+      CHECK(c1.triangle_tests == c2.triangle_tests);
+      CHECK(c1.kd_node_visits > c1.rays);
+      CHECK(c1.triangle_tests > 0);
+      CHECK((std::string(mode) == "bsp" ? c1.bsp_node_visits > 0 : c1.bsp_node_visits == 0));
+    }
+  }
 }
 
 TEST_CASE("path tracing: brute force and Embree give the same image up to ties", "[render]") {
