@@ -24,7 +24,6 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 using detail::ExactRayConst;
 using detail::Stage;
-using detail::same_point;
 
 struct M3 {
   Mp x, y, z;
@@ -208,51 +207,28 @@ std::optional<Candidate> test_one(const Ray& ray, const ExactRayConst& fr, const
   return c;
 }
 
-/// Whether two triangles have the same three corners (in any order).
-bool same_corners(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b) {
-  for (const Vec3f& x : a)
-    if (!same_point(x, b[0]) && !same_point(x, b[1]) && !same_point(x, b[2])) return false;
-  for (const Vec3f& x : b)
-    if (!same_point(x, a[0]) && !same_point(x, a[1]) && !same_point(x, a[2])) return false;
-  return true;
-}
-
-/// The points a hit is known to lie among, by its place (NearestHit::on):
-/// its vertex, the two ends of its edge, or its triangle's three corners.
-/// The hit lies in their convex hull, so in any plane that holds them all.
-int known_points(std::uint8_t on, const Vec3f& p, const Vec3f& q, const std::array<Vec3f, 3>& tri, Vec3f (&out)[3]) {
-  if (on == 1) return out[0] = p, 1;
-  if (on == 2) return out[0] = p, out[1] = q, 2;
-  out[0] = tri[0], out[1] = tri[1], out[2] = tri[2];
-  return 3;
-}
-
 /// Whether two hits lie in one plane parallel to a coordinate axis k, which
 /// the ray crosses: projected along k (coordinates u, v), the points each hit
-/// is known to lie among (known_points) lie on one line L through two of
-/// them, a and b, and the ray's direction is not parallel to L. Both hits
+/// is known to lie among (detail::known_points) lie on one line L through two
+/// of them, a and b, and the ray's direction is not parallel to L. Both hits
 /// then lie on the plane L x axis k, which the ray meets in one point, so
 /// their exact t's are equal. Each test is the exact sign of a sum of
-/// products of floats (exact_sum.h). An axis-aligned plane x_k = c (every
-/// point's coordinate k equal, d[k] != 0) is the common case, checked first:
-/// overlapping coplanar surfaces of architectural models (a panel on a
-/// ceiling, a rug on a floor); 97 of the 98 exact decisions on 90K conference
-/// camera rays (kd) were such ties. Vertical walls and what hangs on them
-/// (conference's slanted walls) are the planes parallel to one axis.
-bool same_plane_along_axis(const Candidate& c, const std::array<Vec3f, 3>& tri, const NearestHit& best,
-                           const std::array<Vec3f, 3>& best_tri, const Ray& ray) {
+/// products of floats (exact_sum.h). Vertical walls and what hangs on them
+/// (conference's slanted walls) are the planes parallel to one axis. The
+/// axis-aligned plane x_k = c, the common case (a panel on a ceiling, a rug
+/// on a floor: 97 of the 98 exact decisions on 90K conference camera rays,
+/// kd, were such ties), needs float comparisons only and is checked first,
+/// by detail::same_t_by_corners.
+bool same_plane_along_axis(const Candidate& c, const std::array<float, 9>& tri, const NearestHit& best,
+                           const Ray& ray) {
   Vec3f pt[6];
   Vec3f a3[3], b3[3];
-  const int na = known_points(c.on, c.p, c.q, tri, a3), nb = known_points(best.on, best.p, best.q, best_tri, b3);
+  const int na = detail::known_points(c.on, c.p, c.q, tri, a3);
+  const int nb = detail::known_points(best.on, best.p, best.q, best.tri, b3);
   int n = 0;
   for (int i = 0; i < na; ++i) pt[n++] = a3[i];
   for (int i = 0; i < nb; ++i) pt[n++] = b3[i];
   const Vec3f& d = ray.dir;
-  for (int k = 0; k < 3; ++k) {  // x_k = c
-    bool same = d[k] != 0.0f;
-    for (int i = 1; i < n && same; ++i) same = pt[i][k] == pt[0][k];
-    if (same) return true;
-  }
   for (int k = 0; k < 3; ++k) {  // a plane containing axis k
     const int u = (k + 1) % 3, v = (k + 2) % 3;
     const Vec3f& a = pt[0];
@@ -281,12 +257,10 @@ bool same_plane_along_axis(const Candidate& c, const std::array<Vec3f, 3>& tri, 
 /// Whether two hits have the same exact t for a reason that needs no
 /// arithmetic beyond exact signs of sums of float products: the same vertex,
 /// the same edge, triangles with the same corners, or hits in one plane
-/// parallel to a coordinate axis that the ray crosses.
-bool same_t_by_rule(const Candidate& c, const std::array<Vec3f, 3>& tri, const NearestHit& best,
-                    const std::array<Vec3f, 3>& best_tri, const Ray& ray) {
-  if (((c.on == 1 && best.on == 1) || (c.on == 2 && best.on == 2)) && detail::same_place(c.on, c.p, c.q, best))
-    return true;
-  return same_corners(tri, best_tri) || same_plane_along_axis(c, tri, best, best_tri, ray);
+/// parallel to a coordinate axis that the ray crosses. The first checks are
+/// the staged test's own (detail::same_t_by_corners).
+bool same_t_by_rule(const Candidate& c, const std::array<float, 9>& tri, const NearestHit& best, const Ray& ray) {
+  return detail::same_t_by_corners(c.on, c.p, c.q, tri, best, ray) || same_plane_along_axis(c, tri, best, ray);
 }
 
 }  // namespace
@@ -315,7 +289,8 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     if (soup_.is_degenerate(prim)) continue;
     const std::array<Vec3f, 3> tri =
         corners ? std::array<Vec3f, 3>{corners[i].v[0], corners[i].v[1], corners[i].v[2]} : soup_.corners(prim);
-    if (detail::vertex_tie(fr, prim, std::bit_cast<std::array<float, 9>>(tri), best)) {
+    const auto tri9 = std::bit_cast<std::array<float, 9>>(tri);
+    if (detail::vertex_tie(fr, prim, tri9, best)) {
       ++st.rule;
       continue;
     }
@@ -327,9 +302,9 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     } else if (c->t_lo > best.t_hi) {
       nearer = false;
     } else {  // enclosures overlap
-      const auto best_tri = soup_.corners(best.hit.prim);
+      const auto best_tri = std::bit_cast<std::array<Vec3f, 3>>(best.tri);
       int order;  // sign(t - best t)
-      if (same_t_by_rule(*c, tri, best, best_tri, ray)) {
+      if (same_t_by_rule(*c, tri9, best, ray)) {
         ++st.rule;
         order = 0;
       } else {
@@ -346,7 +321,7 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
     best.on = c->on;
     best.p = c->p;
     best.q = c->q;
-    best.tri = std::bit_cast<std::array<float, 9>>(tri);
+    best.tri = tri9;
   }
   if (st.exact) fallbacks_.fetch_add(st.exact, std::memory_order_relaxed);
   if (counters) {

@@ -297,27 +297,31 @@ inline bool same_corners(const std::array<float, 9>& a, const std::array<float, 
   return true;
 }
 
+/// The points a hit is known to lie among, by its place (NearestHit::on):
+/// its vertex, the two ends of its edge, or its triangle's three corners.
+/// The hit lies in their convex hull, so in any plane that holds them all.
+inline int known_points(std::uint8_t on, const Vec3f& p, const Vec3f& q, const std::array<float, 9>& tri,
+                        Vec3f (&out)[3]) {
+  if (on == 1) return out[0] = p, 1;
+  if (on == 2) return out[0] = p, out[1] = q, 2;
+  for (int i = 0; i < 3; ++i) out[i] = Vec3f{tri[3 * i], tri[3 * i + 1], tri[3 * i + 2]};
+  return 3;
+}
+
 /// Whether two hits have the same exact t by the rules that need only float
 /// comparisons (docs/exact-leaf-test.md, "Rules on exact zeros"): the same
 /// vertex or edge (rule (b), same_place), triangles with the same corners, or
 /// hits whose known points (the vertex, the edge's ends, else the triangle's
 /// corners) all lie in one axis plane x_k = c that the ray crosses
-/// (d[k] != 0). The exact-decision intersector's same_t_by_rule checks these
+/// (d[k] != 0). The exact-decision intersector's same_t_by_rule calls it
 /// first, so a tie settled here is settled there the same way and counted
 /// as the same rule decision.
 inline bool same_t_by_corners(std::uint8_t on, const Vec3f& p, const Vec3f& q, const std::array<float, 9>& tri,
                               const NearestHit& best, const Ray& ray) {
   if (on != 0 && on == best.on && same_place(on, p, q, best)) return true;
   if (same_corners(tri, best.tri)) return true;
-  const auto known = [](std::uint8_t at, const Vec3f& a, const Vec3f& b, const std::array<float, 9>& t,
-                        Vec3f (&out)[3]) {
-    if (at == 1) return out[0] = a, 1;
-    if (at == 2) return out[0] = a, out[1] = b, 2;
-    for (int i = 0; i < 3; ++i) out[i] = Vec3f{t[3 * i], t[3 * i + 1], t[3 * i + 2]};
-    return 3;
-  };
   Vec3f a3[3], b3[3];
-  const int na = known(on, p, q, tri, a3), nb = known(best.on, best.p, best.q, best.tri, b3);
+  const int na = known_points(on, p, q, tri, a3), nb = known_points(best.on, best.p, best.q, best.tri, b3);
   for (int k = 0; k < 3; ++k) {
     if (ray.dir[k] == 0.0f) continue;
     const float c = a3[0][k];
