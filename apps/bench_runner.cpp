@@ -151,23 +151,67 @@ std::vector<Hit> exact_hits(const TriangleSoup& soup, const std::vector<Ray>& ra
   return hits;
 }
 
-/// Measures one built mode on one ray set (timed rays, error subset, reference).
-BenchRow measure_mode(const BuiltMode& m, const std::vector<Ray>& rays, const std::vector<Ray>& subset,
-                      const std::vector<Hit>& reference, const BenchOptions& o, int isa_width) {
+/// A mode's timing on one ray set: its fastest pass, single rays and packets.
+struct ModeTiming {
+  double single = 1e30;
+  double packet = 1e30;
+  std::size_t hits = 0;  ///< rays of the timed set that hit (single rays, first round)
+};
+
+/// The rays a mode is timed on: slow modes (brute force, the exact
+/// reference) take the error subset, when there is one.
+const std::vector<Ray>& timed_rays(const BuiltMode& m, const std::vector<Ray>& rays,
+                                   const std::vector<Ray>& subset) {
+  return is_slow_mode(m.mode) && !subset.empty() ? subset : rays;
+}
+
+/// Packet width a mode is timed with: certified modes and box tops trace
+/// packets as single rays, so they get no packet row (width 1).
+int packet_width_of(const BuiltMode& m, int isa_width) { return accel_info(m.mode).packets ? isa_width : 1; }
+
+/// Times every mode on one ray set in rounds: each round traces the set once
+/// with every mode (single rays, then packets), so that the slow and fast
+/// phases of a shared machine fall on all modes alike, and a mode's time is
+/// its fastest round. Timing the runs of one mode back to back put whole
+/// phases on one mode: ratios of the same two modes moved by up to 0.2
+/// between runs of the same build (docs/notes/2026-12-07-bench-rounds.md).
+/// Slow modes take one pass. `step` is called once per mode and round.
+std::vector<ModeTiming> time_modes(const std::vector<BuiltMode>& built, const std::vector<Ray>& rays,
+                                   const std::vector<Ray>& subset, const BenchOptions& o, int isa_width,
+                                   const std::function<void(const std::string&)>& step, const std::string& label) {
+  std::vector<ModeTiming> t(built.size());
+  const int rounds = std::max(1, o.runs);
+  std::vector<Hit> hits;
+  for (int r = 0; r < rounds; ++r) {
+    for (std::size_t i = 0; i < built.size(); ++i) {
+      const BuiltMode& m = built[i];
+      step(fmt::format("{}, {}: timing round {} of {}", label, m.mode, r + 1, rounds));
+      if (r > 0 && is_slow_mode(m.mode)) continue;
+      const std::vector<Ray>& timed = timed_rays(m, rays, subset);
+      t[i].single = std::min(t[i].single, time_trace(*m.tracer, timed, hits, 1, 1));
+      if (r == 0)
+        t[i].hits = std::size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.hit(); }));
+      const int width = packet_width_of(m, isa_width);
+      if (width > 1) t[i].packet = std::min(t[i].packet, time_trace(*m.tracer, timed, hits, width, 1));
+    }
+  }
+  return t;
+}
+
+/// One built mode's row on one ray set: its timing (time_modes), work per
+/// ray counted in a separate pass, and its error against the reference.
+BenchRow measure_mode(const BuiltMode& m, const ModeTiming& timing, const std::vector<Ray>& rays,
+                      const std::vector<Ray>& subset, const std::vector<Hit>& reference, int isa_width) {
   BenchRow row;
   row.mode = m.mode;
   row.build_seconds = m.build_seconds;
   row.memory_bytes = m.tracer->memory_bytes();
-  const std::vector<Ray>& timed = is_slow_mode(m.mode) && !subset.empty() ? subset : rays;
+  const std::vector<Ray>& timed = timed_rays(m, rays, subset);
   row.rays = timed.size();
-  std::vector<Hit> hits;
-  const int runs = is_slow_mode(m.mode) ? 1 : o.runs;  // slow modes (brute force, the exact reference): one pass
-  row.mrays_single = double(timed.size()) / time_trace(*m.tracer, timed, hits, 1, runs) * 1e-6;
-  row.hits = std::size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.hit(); }));
-  // Certified modes and box tops trace packets as single rays: no packet row.
-  row.packet_width = accel_info(m.mode).packets ? isa_width : 1;
-  if (row.packet_width > 1)
-    row.mrays_packet = double(timed.size()) / time_trace(*m.tracer, timed, hits, row.packet_width, o.runs) * 1e-6;
+  row.mrays_single = double(timed.size()) / timing.single * 1e-6;
+  row.hits = timing.hits;
+  row.packet_width = packet_width_of(m, isa_width);
+  if (row.packet_width > 1) row.mrays_packet = double(timed.size()) / timing.packet * 1e-6;
   const RayCounters c = count_work(*m.tracer, subset.empty() ? timed : subset);
   const double n = double(std::max<std::uint64_t>(1, c.rays ? c.rays : (subset.empty() ? timed : subset).size()));
   row.kd_visits = double(c.kd_node_visits) / n;
@@ -188,6 +232,12 @@ BenchRow measure_mode(const BuiltMode& m, const std::vector<Ray>& rays, const st
   return row;
 }
 
+/// Progress steps of one ray set: the reference, each mode in each timing
+/// round, and each mode's work and error.
+std::size_t steps_per_set(std::size_t modes, const BenchOptions& o) {
+  return 1 + modes * (std::size_t(std::max(1, o.runs)) + 1);
+}
+
 /// All ray sets of one scene.
 void bench_scene(const BenchScene& scene, const BenchOptions& o, int threads, int isa_width, BenchResult& result,
                  const std::function<void(const std::string&)>& step) {
@@ -196,15 +246,18 @@ void bench_scene(const BenchScene& scene, const BenchOptions& o, int threads, in
     const auto rays = make_ray_set(set, scene, o.count, o.seed, o.cameras);
     if (!rays) {
       result.notes.push_back(fmt::format("{}: ray set '{}' skipped (no known inside region)", scene.name, set));
-      for (std::size_t i = 0; i < built.size() + 1; ++i) step(fmt::format("{}: {} skipped", scene.name, set));
+      for (std::size_t i = 0; i < steps_per_set(built.size(), o); ++i) step(fmt::format("{}: {} skipped", scene.name, set));
       continue;
     }
     const std::vector<Ray> subset = o.error_count ? strided_subset(*rays, o.error_count) : std::vector<Ray>{};
     step(fmt::format("{}: exact reference on {} {} rays", scene.name, subset.size(), set));
     const std::vector<Hit> reference = subset.empty() ? std::vector<Hit>{} : exact_hits(scene.soup, subset);
-    for (const BuiltMode& m : built) {
-      step(fmt::format("{}: {} rays, {}", scene.name, set, m.mode));
-      BenchRow row = measure_mode(m, *rays, subset, reference, o, isa_width);
+    const std::vector<ModeTiming> timing =
+        time_modes(built, *rays, subset, o, isa_width, step, fmt::format("{}: {} rays", scene.name, set));
+    for (std::size_t i = 0; i < built.size(); ++i) {
+      const BuiltMode& m = built[i];
+      step(fmt::format("{}: {} rays, {}: work and error", scene.name, set, m.mode));
+      BenchRow row = measure_mode(m, timing[i], *rays, subset, reference, isa_width);
       row.scene = scene.name;
       row.triangles = scene.soup.size();
       row.ray_set = set;
@@ -300,7 +353,7 @@ BenchResult run_bench(const std::vector<BenchScene>& scenes, const BenchOptions&
   result.packet_width = isa_width(isa);
   tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
   result.threads = arena.max_concurrency();
-  const std::size_t total = scenes.size() * (o.modes.size() + o.ray_sets.size() * (o.modes.size() + 1));
+  const std::size_t total = scenes.size() * (o.modes.size() + o.ray_sets.size() * steps_per_set(o.modes.size(), o));
   std::size_t done = 0;
   const auto step = [&](const std::string& what) {
     if (o.progress) o.progress(what, done, total);

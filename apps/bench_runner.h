@@ -53,7 +53,7 @@ struct BenchOptions {
   std::size_t count = 262144;      ///< rays per set for speed and counters
   std::size_t error_count = 20000;  ///< rays per set checked against the exact reference (0 = no error part)
   int threads = 0;                  ///< worker threads for every mode (0 = all cores)
-  int runs = 2;                     ///< timing passes per measurement; the fastest counts
+  int runs = 2;                     ///< timing rounds: each times every mode once; a mode's fastest counts
   std::uint64_t seed = 1;           ///< ray-set seed
   /// Cameras by scene (bench --cameras FILE, geometry/io/camera_file.h): a
   /// scene with one traces its primary rays from it (e.g. sponza's atrium),

@@ -112,7 +112,7 @@ void register_bench(CLI::App& app) {
   cmd->add_option("--error-count", args->error_count, "rays per set checked against the exact reference (0 = none)")
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads for every mode (0 = all cores)")->capture_default_str();
-  cmd->add_option("--runs", args->runs, "timing passes; the fastest counts")->capture_default_str();
+  cmd->add_option("--runs", args->runs, "timing rounds: each round times every mode once (single rays, then packets), and a mode's fastest round counts")->capture_default_str();
   cmd->add_option("--seed", args->seed, "ray-set seed")->capture_default_str();
   cmd->add_option("--cameras", args->cameras,
                   "camera file (e.g. bench/cameras.json): a scene it names traces its primary rays from that camera");

@@ -5,7 +5,7 @@
 #   scripts/docs.sh                 # everything
 #   BSPRT_DOCS_BUILD=dir BSPRT_DOCS_JOBS=1 scripts/docs.sh   # another build dir, fewer compile jobs
 # Tunables (defaults sized for the 15-minute budget): COUNT, ERROR_COUNT,
-# VERTEX_COUNT, SCALING_LEVELS, GALLERY_SIZE, GALLERY_SPP.
+# VERTEX_COUNT, SCALING_LEVELS, GALLERY_SIZE, GALLERY_SPP, RUNS.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -17,6 +17,7 @@ VERTEX_COUNT=${VERTEX_COUNT:-50000}
 SCALING_LEVELS=${SCALING_LEVELS:-"3 4 5 6 7"}
 GALLERY_SIZE=${GALLERY_SIZE:-"480 360"}
 GALLERY_SPP=${GALLERY_SPP:-16}
+RUNS=${RUNS:-3}  # bench timing rounds (each times every mode once; the fastest round counts)
 PERF=docs/perf
 GAL=docs/gallery
 start=$(date +%s)
@@ -35,7 +36,7 @@ for m in "${MESHES[@]}"; do mesh_paths+=("$SCENES/$m"); done
 MODES=kd,kd-float,bsp,bsp-float,bsp-top,bsp-zero-eps,bvh8,bvh8-float,embree,embree-fast
 
 # 1. Every mode, every mesh, four ray sets: speed, work, memory, error.
-BENCH_CMD=(bench "${mesh_paths[@]}" --rays primary,random,vertex,edge --modes "$MODES"
+BENCH_CMD=(bench --runs "$RUNS" "${mesh_paths[@]}" --rays primary,random,vertex,edge --modes "$MODES"
            --count "$COUNT" --error-count "$ERROR_COUNT" -o "$PERF" --prefix bench)
 "$BSPRT" "${BENCH_CMD[@]}" | tee "$PERF/bench.txt"
 # 1b. The other meshes of ../shared/scenes/ (small, and the stiff ones), fewer rays.
@@ -44,19 +45,19 @@ SMALL=(cube.obj cornell_box.obj stiff_cube_with_fold.ply stiff_degenerated.obj s
        stiff_sliver_tet.ply stiff_truck.obj stiff_two-boxes-bad-self-union.ply)
 small_paths=()
 for m in "${SMALL[@]}"; do small_paths+=("$SCENES/$m"); done
-SMALL_CMD=(bench "${small_paths[@]}" --rays primary,random,vertex,edge --modes "$MODES"
+SMALL_CMD=(bench --runs "$RUNS" "${small_paths[@]}" --rays primary,random,vertex,edge --modes "$MODES"
            --count 20000 --error-count 5000 -o "$PERF" --prefix small)
 "$BSPRT" "${SMALL_CMD[@]}" | tee "$PERF/small.txt"
 # 2. The key finding: rays aimed at the bunny's vertices, more of them.
-VERTEX_CMD=(bench "$SCENES/stanford-bunny.obj" --rays vertex --modes "$MODES"
+VERTEX_CMD=(bench --runs "$RUNS" "$SCENES/stanford-bunny.obj" --rays vertex --modes "$MODES"
             --count "$VERTEX_COUNT" --error-count "$VERTEX_COUNT" --seed 7 -o "$PERF" --prefix vertex-bunny)
 "$BSPRT" "${VERTEX_CMD[@]}" | tee "$PERF/vertex-bunny.txt"
 # 3. Rays from inside closed generated icospheres (every ray must hit: a miss is a leak).
-INSIDE_CMD=(bench icosphere:4 icosphere:6 --rays inside,vertex --modes "$MODES" --count "$COUNT"
+INSIDE_CMD=(bench --runs "$RUNS" icosphere:4 icosphere:6 --rays inside,vertex --modes "$MODES" --count "$COUNT"
             --error-count "$ERROR_COUNT" -o "$PERF" --prefix inside)
 "$BSPRT" "${INSIDE_CMD[@]}" | tee "$PERF/inside.txt"
 # 3b. Every triangle listed twice, the copy with reversed winding (issue #23): each hit ties with its copy.
-TWINS_CMD=(bench "twin:$SCENES/utah-teapot.obj" "twin:$SCENES/stanford-bunny.obj" --rays primary,random,vertex,edge
+TWINS_CMD=(bench --runs "$RUNS" "twin:$SCENES/utah-teapot.obj" "twin:$SCENES/stanford-bunny.obj" --rays primary,random,vertex,edge
            --modes kd,kd-float,bsp,bsp-float,embree --count "$COUNT" --error-count "$ERROR_COUNT" -o "$PERF"
            --prefix twins)
 "$BSPRT" "${TWINS_CMD[@]}" | tee "$PERF/twins.txt"
@@ -65,13 +66,13 @@ TWINS_CMD=(bench "twin:$SCENES/utah-teapot.obj" "twin:$SCENES/stanford-bunny.obj
 scaling_scenes=()
 for l in $SCALING_LEVELS; do scaling_scenes+=("icosphere:$l"); done
 scaling_scenes+=("$SCENES/stanford-dragon-871k.ply")
-SCALING_CMD=(bench "${scaling_scenes[@]}" --rays random --modes kd,bsp,embree --count 65536 --error-count 0
+SCALING_CMD=(bench --runs "$RUNS" "${scaling_scenes[@]}" --rays random --modes kd,bsp,embree --count 65536 --error-count 0
              -o "$PERF" --prefix scaling)
 "$BSPRT" "${SCALING_CMD[@]}" | tee "$PERF/scaling.txt"
 
 # 5. Plots.
 # The paper's regime: architectural scenes seen from inside (bench/cameras.json).
-INTERIOR_CMD=(bench "$SCENES/sponza.obj" "$SCENES/conference-331k.obj" --cameras bench/cameras.json
+INTERIOR_CMD=(bench --runs "$RUNS" "$SCENES/sponza.obj" "$SCENES/conference-331k.obj" --cameras bench/cameras.json
               --rays primary,random,vertex,edge --modes "$MODES" --count "$COUNT" --error-count "$ERROR_COUNT"
               -o "$PERF" --prefix interior)
 "$BSPRT" "${INTERIOR_CMD[@]}" | tee "$PERF/interior.txt"
@@ -109,6 +110,6 @@ done
 GALLERY_LIST="${GALLERY[*]}" BENCH_CMD="bsprt ${BENCH_CMD[*]}" VERTEX_CMD="bsprt ${VERTEX_CMD[*]}" \
   INSIDE_CMD="bsprt ${INSIDE_CMD[*]}" TWINS_CMD="bsprt ${TWINS_CMD[*]}" INTERIOR_CMD="bsprt ${INTERIOR_CMD[*]}" SMALL_CMD="bsprt ${SMALL_CMD[*]}" SCALING_CMD="bsprt ${SCALING_CMD[*]}" ELAPSED=$(($(date +%s) - start)) \
   SCENES="$SCENES" BUILD="$BUILD" GW="$GW" GH="$GH" SPP="$GALLERY_SPP" ERROR_COUNT="$ERROR_COUNT" \
-  SCALING_LEVELS="$SCALING_LEVELS" \
+  SCALING_LEVELS="$SCALING_LEVELS" RUNS="$RUNS" \
   scripts/docs_write_performance.sh > docs/performance.md
 echo "docs: wrote docs/performance.md, $PERF/, $GAL/ in $(($(date +%s) - start)) s"

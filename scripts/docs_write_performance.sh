@@ -79,8 +79,9 @@ subtrees of ≤ 1024 slots (single rays only, exact leaves; docs/certified-epsil
 triangle, decided exactly. Error is measured ray by ray against \`ExactTracer\` (CGAL exact
 ray/triangle intersection on the same float rays), in the vocabulary of \`bsprt compare\`: *lost* (reference
 hits, mode misses), *farther* (a leak: the mode reports a surface behind the exact nearest one),
-*extra*, *nearer*, and |t − t_exact| in ulps. Speed: Mrays/s of all threads, best of 2 passes over the
-same rays, timing the traversal only (rays checked and output touched before; Embree through this
+*extra*, *nearer*, and |t − t_exact| in ulps. Speed: Mrays/s of all threads, the fastest of ${RUNS:-3} timing rounds over the
+same rays, each round tracing the set once with every mode, so that the machine's slow phases fall on all
+modes alike (docs/notes/2026-12-07-bench-rounds.md); timing the traversal only (rays checked and output touched before; Embree through this
 harness runs within 2 % of a plain \`rtcIntersect1\` loop, docs/notes/2026-12-01-timing-harness.md);
 primary rays in 8×8 tiles. Packets: a BSP packet whose rays spread over more than about 8° runs as
 single rays (docs/certified-epsilons.md §5), and so does a kd packet of mixed direction signs; Embree's

@@ -211,3 +211,54 @@ TEST_CASE("bench: twin:SCENE lists every triangle twice, and the certified modes
   }
   CHECK(rows == 9);
 }
+
+TEST_CASE("bench: every mode is timed once per round, and progress ends exactly at its total", "[bench]") {
+  std::vector<BenchScene> scenes;
+  scenes.push_back(load_bench_scene("icosphere:1"));
+  BenchOptions o;
+  o.ray_sets = {"primary", "random"};
+  o.modes = {"bsp", "kd", "bsp-float"};
+  o.count = 256;
+  o.error_count = 0;
+  o.threads = 1;
+  o.runs = 3;
+  std::vector<std::pair<std::string, std::size_t>> calls;
+  std::size_t total = 0;
+  o.progress = [&](const std::string& what, std::size_t done, std::size_t of) {
+    calls.emplace_back(what, done);
+    total = of;
+  };
+  const BenchResult r = run_bench(scenes, o);
+  REQUIRE(r.rows.size() == 2 * 3);
+  // Steps in order, 0, 1, ..., total - 1, then "done" at the total.
+  REQUIRE(calls.size() == total + 1);
+  for (std::size_t i = 0; i < total; ++i) CHECK(calls[i].second == i);
+  CHECK(calls.back().first == "done");
+  CHECK(calls.back().second == total);
+  // Rounds: each round times every mode once, in the order of the modes.
+  std::vector<std::string> timing;
+  for (const auto& [what, done] : calls)
+    if (what.find("timing round") != std::string::npos) timing.push_back(what);
+  REQUIRE(timing.size() == 2 * 3 * 3);
+  for (std::size_t set = 0; set < 2; ++set)
+    for (std::size_t round = 0; round < 3; ++round)
+      for (std::size_t m = 0; m < 3; ++m) {
+        const std::string& s = timing[(set * 3 + round) * 3 + m];
+        CHECK(s.find(", " + o.modes[m] + ": timing round " + std::to_string(round + 1) + " of 3") !=
+              std::string::npos);
+      }
+  // The hits counted in the first round are the modes' own: the exact modes
+  // agree with each other on every ray set.
+  for (const std::string set : {"primary", "random"}) {
+    std::size_t bsp = 0, kd = 0;
+    for (const BenchRow& row : r.rows) {
+      if (row.ray_set != set) continue;
+      CHECK(row.mrays_single > 0.0);
+      if (r.packet_width > 1) CHECK(row.mrays_packet > 0.0);  // bsp, kd and bsp-float all trace packets
+      if (row.mode == "bsp") bsp = row.hits;
+      if (row.mode == "kd") kd = row.hits;
+    }
+    CHECK(bsp > 0);
+    CHECK(bsp == kd);
+  }
+}
