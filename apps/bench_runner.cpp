@@ -173,14 +173,14 @@ int packet_width_of(const BuiltMode& m, int isa_width) { return accel_info(m.mod
 /// with every mode (single rays, then packets), so that the slow and fast
 /// phases of a shared machine fall on all modes alike, and a mode's time is
 /// its fastest round. Timing the runs of one mode back to back put whole
-/// phases on one mode: ratios of the same two modes moved by up to 0.2
-/// between runs of the same build (docs/notes/2026-12-07-bench-rounds.md).
+/// phases on one mode: ratios of the same two modes moved by up to 0.28
+/// between runs of the same build, 0.12 in rounds (docs/notes/2026-12-07-bench-rounds.md).
 /// Slow modes take one pass. `step` is called once per mode and round.
 std::vector<ModeTiming> time_modes(const std::vector<BuiltMode>& built, const std::vector<Ray>& rays,
                                    const std::vector<Ray>& subset, const BenchOptions& o, int isa_width,
                                    const std::function<void(const std::string&)>& step, const std::string& label) {
   std::vector<ModeTiming> t(built.size());
-  const int rounds = std::max(1, o.runs);
+  const int rounds = o.runs;  // at least 1 (check_options)
   std::vector<Hit> hits;
   for (int r = 0; r < rounds; ++r) {
     for (std::size_t i = 0; i < built.size(); ++i) {
@@ -235,7 +235,7 @@ BenchRow measure_mode(const BuiltMode& m, const ModeTiming& timing, const std::v
 /// Progress steps of one ray set: the reference, each mode in each timing
 /// round, and each mode's work and error.
 std::size_t steps_per_set(std::size_t modes, const BenchOptions& o) {
-  return 1 + modes * (std::size_t(std::max(1, o.runs)) + 1);
+  return 1 + modes * (std::size_t(o.runs) + 1);
 }
 
 /// All ray sets of one scene.
@@ -274,6 +274,7 @@ void check_options(const BenchOptions& o) {
   for (const std::string& s : o.ray_sets)
     if (s != "inside") (void)parse_ray_set(s);
   if (o.count == 0) throw UsageError("bench: --count must be positive");
+  if (o.runs < 1) throw UsageError("bench: --runs must be at least 1, not " + std::to_string(o.runs));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include "apps/bench_report.h"
 #include "apps/bench_runner.h"
+#include "bsprt/error.h"
 
 using namespace bsprt;
 
@@ -151,6 +152,9 @@ TEST_CASE("bench: bad modes, ray sets and scenes are usage errors", "[bench]") {
   o.modes = {"kd"};
   o.ray_sets = {"sideways"};
   CHECK_THROWS(run_bench({}, o));
+  o.ray_sets = {"primary"};
+  o.runs = 0;  // no timing round: a usage error, not a silent single pass
+  CHECK_THROWS_AS(run_bench({}, o), UsageError);
   CHECK_THROWS(load_bench_scene("icosphere:x"));
 }
 
