@@ -459,6 +459,34 @@ template <bool kAnyHit = false, class Fr, class TStage, class Open>
 /// the caller. kAnyHit (occluded): a hit certainly in [tnear, tfar] is taken
 /// without rounding its t (staged_decide), so `best` then holds some hit, not
 /// necessarily with the nearest float t; only whether there is one counts.
+/// One triangle of exact_leaf_staged, its corners given as nine floats
+/// (`tri`; a traversal may gather them from its own rows): the same decision,
+/// with the same counts added to `tests` and `rules`. Whatever the stages
+/// leave open goes to the intersector with the corners written out.
+template <bool kAnyHit = false>
+[[gnu::always_inline]] inline void exact_one_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
+                                                    std::uint32_t prim, const std::array<float, 9>& tri,
+                                                    NearestHit& best, RayCounters* c, std::uint64_t& tests,
+                                                    std::uint64_t& rules) {
+  const auto open = [&] {
+    const LeafTriangle corners = std::bit_cast<LeafTriangle>(tri);
+    x.intersect(ray, std::span<const std::uint32_t>(&prim, 1), &corners, best, c);
+  };
+  if (best.hit.hit() && prim == best.hit.prim) {  // met again in another leaf: not nearer than itself
+    ++tests;
+    return;
+  }
+  if (vertex_tie(fr, prim, tri, best)) {
+    ++tests, ++rules;
+    return;
+  }
+  StageWeights sw;
+  const Stage ws = double_weights(fr, tri, sw);
+  const auto tstage = [&](float& t, double& lo, double& hi) { return double_t(fr, ray, tri, t, lo, hi); };
+  staged_decide<kAnyHit>([&]() -> const ExactRayConst& { return fr; }, ray, prim, tri, ws, sw, tstage, open, best,
+                         tests, rules);
+}
+
 template <bool kAnyHit = false>
 [[gnu::always_inline]] inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
                                                      const std::uint32_t* prims, const LeafTriangle* corners,
@@ -468,24 +496,8 @@ template <bool kAnyHit = false>
     return;
   }
   std::uint64_t tests = 0, rules = 0;
-  for (std::uint32_t i = 0; i < count; ++i) {
-    const std::uint32_t prim = prims[i];
-    const auto open = [&] { x.intersect(ray, std::span<const std::uint32_t>(prims + i, 1), corners + i, best, c); };
-    if (best.hit.hit() && prim == best.hit.prim) {  // met again in another leaf: not nearer than itself
-      ++tests;
-      continue;
-    }
-    const std::array<float, 9> tri = corner_floats(corners[i]);
-    if (vertex_tie(fr, prim, tri, best)) {
-      ++tests, ++rules;
-      continue;
-    }
-    StageWeights sw;
-    const Stage ws = double_weights(fr, tri, sw);
-    const auto tstage = [&](float& t, double& lo, double& hi) { return double_t(fr, ray, tri, t, lo, hi); };
-    staged_decide<kAnyHit>([&]() -> const ExactRayConst& { return fr; }, ray, prim, tri, ws, sw, tstage, open, best,
-                           tests, rules);
-  }
+  for (std::uint32_t i = 0; i < count; ++i)
+    exact_one_staged<kAnyHit>(x, ray, fr, prims[i], corner_floats(corners[i]), best, c, tests, rules);
   if (c) c->triangle_tests += tests, c->rule_decisions += rules;
 }
 
