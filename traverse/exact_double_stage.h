@@ -444,25 +444,12 @@ template <bool kAnyHit = false, class Fr, class TStage, class Open>
   best.tri = tri;
 }
 
-/// LeafIntersector::intersect(ray, prims[0..count), corners, best, counters),
-/// with the double stage and the rules on exact zeros inline when the
-/// intersector allows it (LeafIntersector::staged()). A triangle is settled
-/// here when the double stage, with rule (a) for what it leaves open, decides
-/// its weights and its t, and its t enclosure is clear of the nearest hit's
-/// or ties with it at the same corner or edge (rule (b)). Any other triangle
-/// (a sign or a t for the exact stage, an overlap only the intersector can
-/// settle) goes to the intersector alone, before anything about it is
-/// counted. The intersector decides a settled triangle the same way (it runs
-/// these functions first, in the same order) and keeps the nearest by the
-/// same comparisons, so the answer, the enclosure and the counters are its
-/// own. `ray` must be valid. `fr` = exact_ray_const(ray), made once per ray by
-/// the caller. kAnyHit (occluded): a hit certainly in [tnear, tfar] is taken
-/// without rounding its t (staged_decide), so `best` then holds some hit, not
-/// necessarily with the nearest float t; only whether there is one counts.
 /// One triangle of exact_leaf_staged, its corners given as nine floats
 /// (`tri`; a traversal may gather them from its own rows): the same decision,
 /// with the same counts added to `tests` and `rules`. Whatever the stages
-/// leave open goes to the intersector with the corners written out.
+/// leave open goes to the intersector with the corners written out. The
+/// caller checks what exact_leaf_staged checks first: x.staged(), and the
+/// test hook exact_filter_off_for_testing off.
 template <bool kAnyHit = false>
 [[gnu::always_inline]] inline void exact_one_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
                                                     std::uint32_t prim, const std::array<float, 9>& tri,
@@ -487,6 +474,21 @@ template <bool kAnyHit = false>
                          tests, rules);
 }
 
+/// LeafIntersector::intersect(ray, prims[0..count), corners, best, counters),
+/// with the double stage and the rules on exact zeros inline when the
+/// intersector allows it (LeafIntersector::staged()). A triangle is settled
+/// here when the double stage, with rule (a) for what it leaves open, decides
+/// its weights and its t, and its t enclosure is clear of the nearest hit's
+/// or ties with it at the same corner or edge (rule (b)). Any other triangle
+/// (a sign or a t for the exact stage, an overlap only the intersector can
+/// settle) goes to the intersector alone, before anything about it is
+/// counted. The intersector decides a settled triangle the same way (it runs
+/// these functions first, in the same order) and keeps the nearest by the
+/// same comparisons, so the answer, the enclosure and the counters are its
+/// own. `ray` must be valid. `fr` = exact_ray_const(ray), made once per ray by
+/// the caller. kAnyHit (occluded): a hit certainly in [tnear, tfar] is taken
+/// without rounding its t (staged_decide), so `best` then holds some hit, not
+/// necessarily with the nearest float t; only whether there is one counts.
 template <bool kAnyHit = false>
 [[gnu::always_inline]] inline void exact_leaf_staged(const LeafIntersector& x, const Ray& ray, const ExactRayConst& fr,
                                                      const std::uint32_t* prims, const LeafTriangle* corners,

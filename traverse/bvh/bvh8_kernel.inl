@@ -306,9 +306,10 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
         } else if (lanes != 0 && v.exact_leaf->staged() && exact_filter_off_for_testing == 0) {
           // Some left out: the others' corners come from the SoA rows the
           // filter has just read, not from the triangle list, another cache
-          // line that random rays miss (11 % of bvh8's time on random bunny
-          // rays; with every lane, camera rays found the gather dearer than
-          // the list, which they have in cache: docs/notes/2026-12-07-exact-leaf-rows.md).
+          // line, which random rays miss (500K random bunny rays: 0.109 s ->
+          // 0.097 s). A leaf whose every lane survives still reads the list:
+          // camera rays have it in cache, and gathering all lanes made them
+          // 4-9 % slower (docs/notes/2026-12-07-exact-leaf-rows.md).
           const ExactRayConst& fr = er.get(ray);
           std::uint64_t tests = 0, rules = 0;
           for (unsigned m = lanes; m; m &= m - 1) {
