@@ -6,7 +6,8 @@
 # copied aside and the current one) or two modes of one build alternate in
 # one sitting: this VM's speed drifts by up to 1.5x between sittings, so
 # only times taken this way are compared in the lab notes. It also checks
-# that variants of one accelerator wrote byte-identical hits.
+# that variants of one accelerator wrote byte-identical hits, and exits 1
+# (after the table) when they did not.
 #   scripts/ab_trace.sh SCENE RAYS TREE ROUNDS label:BIN:accel ...
 #   scripts/ab_trace.sh sponza.obj cam.rays sponza.bsp 5 old:/tmp/bsprt.old:bsp new:build/apps/bsprt:bsp
 # TREE is passed to bsp* accelerators; KD_TREE=file passes one to kd*.
@@ -49,12 +50,16 @@ printf '%-16s %s\n' variant "best of $rounds rounds (s)"
 for label in "${labels[@]}"; do printf '%-16s %s\n' "$label" "${best[$label]}"; done
 # Same accelerator, different binaries: the hits must not differ.
 declare -A first_of
+status=0
 for spec in "$@"; do
   IFS=: read -r label bin accel <<<"$spec"
   if [ -n "${first_of[$accel]:-}" ]; then
-    cmp -s "$out/${first_of[$accel]}.hits" "$out/$label.hits" ||
+    if ! cmp -s "$out/${first_of[$accel]}.hits" "$out/$label.hits"; then
       echo "ab_trace.sh: $label and ${first_of[$accel]} ($accel) wrote different hits" >&2
+      status=1
+    fi
   else
     first_of[$accel]=$label
   fi
 done
+exit $status
