@@ -199,6 +199,9 @@ std::optional<Candidate> test_one(const Ray& ray, const ExactRayConst& fr, const
     ++st.exact;
     const ExactT e = exact_t(ray, tri);
     const double tnear = ray.tnear, tfar = ray.tfar;
+    // An infinite bound on the wrong side ([+inf, +inf], [-inf, -inf]) admits no finite t.
+    if (tnear == std::numeric_limits<double>::infinity() || tfar == -std::numeric_limits<double>::infinity())
+      return std::nullopt;
     if (std::isfinite(tnear) && compare_t(e, tnear) < 0) return std::nullopt;
     if (std::isfinite(tfar) && compare_t(e, tfar) > 0) return std::nullopt;
     c.t = round_exact(e, c.t_lo, c.t_hi);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -165,6 +166,12 @@ Hit ExactTracer::trace(const Ray& ray, RayCounters* counters) const {
   if (counters) ++counters->rays;
   Hit best;
   if (!is_valid(ray) || impl_->triangles.empty()) return best;
+  // No finite t lies in [+inf, +inf] or in [-inf, -inf] (a valid ray has
+  // tnear <= tfar, so these are the segments with an infinite bound on the
+  // wrong side), and a hit beyond the float range is no hit: such a segment
+  // holds none. The bounds below cannot say so, since they drop infinite ends.
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  if (ray.tnear == kInf || ray.tfar == -kInf) return best;
   std::vector<std::uint32_t> candidates;
   touched(ray, candidates);
   if (candidates.empty()) return best;

@@ -49,6 +49,8 @@ std::optional<Q> reference_t(const Ray& r, const std::array<Vec3f, 3>& tri) {
   if ((neg && pos) || !(neg || pos)) return std::nullopt;
   const Q3 n = qcross(qsub(q3(tri[1]), q3(tri[0])), qsub(q3(tri[2]), q3(tri[0])));
   const Q t = qdot(n, a0) / qdot(n, d);
+  if (r.tnear == std::numeric_limits<float>::infinity() || r.tfar == -std::numeric_limits<float>::infinity())
+    return std::nullopt;  // no finite t in [+inf, +inf] or [-inf, -inf]
   if (std::isfinite(r.tnear) && t < Q(double(r.tnear))) return std::nullopt;
   if (std::isfinite(r.tfar) && t > Q(double(r.tfar))) return std::nullopt;
   if (nearest_float(t) == std::numeric_limits<float>::infinity()) return std::nullopt;

@@ -10,6 +10,7 @@
 #include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
 #include "geometry/io/load_mesh.h"
+#include "builder/accel_factory.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 #include "traverse/brute_force.h"
@@ -197,5 +198,32 @@ TEST_CASE("exact reference: a hit rounding to -inf is skipped, a farther finite 
     CHECK(h.prim == 1);
     CHECK(std::isfinite(h.t));
     CHECK(h.t > 1e36f);
+  }
+}
+
+// Found by a review of the Python module (2026-12-07): the exact reference
+// dropped an infinite bound whatever its side, so a ray with tnear = tfar =
+// +inf (or -inf) hit the triangle in front of it, while every certified mode
+// missed, and `compare` then counted the correct modes as "lost". No finite t
+// lies in [+inf, +inf] or [-inf, -inf], and a hit beyond the float range is
+// no hit, so both segments hold none, in every accelerator.
+TEST_CASE("exact reference: a segment at +inf or at -inf holds no hit, in every accelerator", "[regression]") {
+  TriangleSoup s;
+  add_tri(s, {-1, -1, 1}, {3, -1, 1}, {-1, 3, 1});
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const std::string& name : accel_names()) {
+    CAPTURE(name);
+    const std::unique_ptr<Accelerator> t = make_tracer(name, s, AccelOptions{});
+    Ray r = ray_of({0.25f, 0.25f, 0}, {0, 0, 1});
+    REQUIRE(t->trace(r).prim == 0);  // the triangle is in front, at t = 1
+    r.tnear = r.tfar = inf;
+    CHECK(!t->trace(r).hit());
+    // Embree refuses tnear < 0 (a UsageError, docs/api.md); every other mode traces it.
+    if (name.rfind("embree", 0) == 0) continue;
+    r.tnear = r.tfar = -inf;
+    CHECK(!t->trace(r).hit());
+    r.dir = {0, 0, -1};  // the plane behind the origin, at t = -1: in [-inf, +inf]
+    r.tfar = inf;
+    CHECK(t->trace(r).prim == 0);
   }
 }
