@@ -6,6 +6,7 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include "builder/accel_factory.h"
+#include "traverse/embree/embree_tracer.h"
 #include "traverse/trace_parallel.h"
 
 namespace bsprt {
@@ -60,8 +61,19 @@ void for_blocks(std::size_t n, const TraceOptions& o, F&& body) {
   run();
 }
 
+/// Embree traces a subset of the valid rays (embree_cannot_trace): name the
+/// first it cannot by its index in the whole batch, before any block runs
+/// (inside a block the tracer knows only the index within that block).
+void check_domain(const Tracer::Impl& impl, std::span<const Ray> rays) {
+  if (!accel_info(impl.name).embree_domain) return;
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    if (const char* why = embree_cannot_trace(rays[i]))
+      throw UsageError(impl.name + ": ray " + std::to_string(i) + " has " + why +
+                       "; such a ray is valid (formats.md): kd, bsp, brute and exact trace it");
+}
+
 void check_options(const TraceOptions& o) {
-  if (o.threads < 0) throw UsageError("TraceOptions::threads must be >= 0, not " + std::to_string(o.threads));
+  check_threads(o.threads, "TraceOptions::threads");
   if (o.packet_width != 1 && o.packet_width != 4 && o.packet_width != 8 && o.packet_width != 16)
     throw UsageError("TraceOptions::packet_width must be 1, 4, 8 or 16, not " + std::to_string(o.packet_width));
 }
@@ -86,6 +98,7 @@ void Tracer::intersect(std::span<const Ray> rays, std::span<Hit> hits, const Tra
   if (rays.size() != hits.size())
     throw UsageError("intersect: " + std::to_string(rays.size()) + " rays but room for " + std::to_string(hits.size()) +
                      " hits");
+  check_domain(*impl_, rays);
   for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
     impl_->accel->trace_batch(rays.subspan(b, e - b), hits.subspan(b, e - b), options.packet_width);
   });
@@ -98,6 +111,7 @@ void Tracer::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occlude
   if (rays.size() != occluded.size())
     throw UsageError("occluded: " + std::to_string(rays.size()) + " rays but room for " +
                      std::to_string(occluded.size()) + " answers");
+  check_domain(*impl_, rays);
   for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
     if (options.packet_width <= 1) {  // single rays: the tracer's own any-hit query (the BVH8 stops at a first hit)
       for (std::size_t i = b; i < e; ++i) occluded[i] = impl_->accel->occluded(rays[i]) ? 1 : 0;

@@ -13,6 +13,7 @@
 #include "builder/kd/kd_build.h"
 #include "builder/kd/kd_file.h"
 #include "builder/tree_file.h"
+#include "bsprt/error.h"
 #include "verify/verify_file.h"
 #include "verify/verify.h"
 
@@ -66,6 +67,7 @@ std::vector<std::byte> build_bsp_bytes(const TriangleSoup& soup, const BuildOpti
 }  // namespace
 
 Tree build(const Scene& scene, const BuildOptions& options) {
+  check_threads(options.threads, "BuildOptions::threads");
   const auto t0 = Clock::now();
   const BuildMonitor monitor{options};
   auto impl = std::make_shared<Tree::Impl>(Tree::Impl{scene, {}, nullptr, 0.0});
@@ -134,6 +136,7 @@ Certificate verify_bsp_tree(const TriangleSoup& soup, const TreeFileReader& file
 Certificate verify(const Scene& scene, const Tree& tree, const VerifyOptions& options) {
   if (tree.scene().fingerprint() != scene.fingerprint() || tree.scene().triangle_count() != scene.triangle_count())
     throw UsageError("verify: the tree was built for another scene (fingerprint mismatch)");
+  check_threads(options.threads, "VerifyOptions::threads");
   const auto t0 = Clock::now();
   const TreeFileReader& file = *tree.file();
   auto run = [&] {

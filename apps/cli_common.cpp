@@ -1,5 +1,9 @@
 #include "apps/cli_common.h"
 
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <optional>
 #include <vector>
 
 #include <fmt/core.h>
@@ -10,13 +14,71 @@
 
 namespace bsprt::cli {
 
+namespace {
+/// The text of an option value as a double, or nullopt when it is not a whole number literal.
+std::optional<double> as_number(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size()) return std::nullopt;
+  return v;
+}
+}  // namespace
+
+CLI::Validator number_above(double lo) {
+  return CLI::Validator(
+      [lo](std::string& s) -> std::string {
+        const std::optional<double> v = as_number(s);
+        return v && *v > lo ? "" : fmt::format("must be a number > {}, not '{}'", lo, s);
+      },
+      fmt::format("NUMBER > {}", lo));
+}
+
+CLI::Validator number_at_least(double lo) {
+  return CLI::Validator(
+      [lo](std::string& s) -> std::string {
+        const std::optional<double> v = as_number(s);
+        return v && *v >= lo && std::isfinite(*v) ? "" : fmt::format("must be a finite number >= {}, not '{}'", lo, s);
+      },
+      fmt::format("NUMBER >= {}", lo));
+}
+
+CLI::Validator number_in_open(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& s) -> std::string {
+        const std::optional<double> v = as_number(s);
+        return v && *v > lo && *v < hi ? "" : fmt::format("must be a number in ({}, {}), not '{}'", lo, hi, s);
+      },
+      fmt::format("NUMBER in ({}, {})", lo, hi));
+}
+
+CLI::Validator integer_in(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& s) -> std::string {
+        const std::optional<double> v = as_number(s);
+        const bool ok = v && *v >= double(lo) && *v <= double(hi) && *v == std::floor(*v) &&
+                        s.find_first_of(".eE") == std::string::npos;
+        return ok ? "" : fmt::format("must be a whole number from {} to {}, not '{}'", lo, hi, s);
+      },
+      fmt::format("INT in [{}, {}]", lo, hi));
+}
+
+void reject_given(const CLI::App& cmd, const std::vector<std::string>& names, const std::string& why) {
+  std::string given;
+  for (const std::string& n : names)
+    if (cmd.get_option(n)->count() > 0) given += (given.empty() ? "" : ", ") + n;
+  if (!given.empty()) throw UsageError(given + ": " + why);
+}
+
 void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& default_accel) {
   o.accel = default_accel;
   std::string names;
   for (const std::string& n : accel_names()) names += (names.empty() ? "" : "|") + n;
   cmd.add_option("--accel", o.accel, "accelerator: " + names)->capture_default_str();
   cmd.add_option("--tree", o.tree, "tree file written by `bsprt build` (kd, bsp); built in memory if absent");
-  cmd.add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd.add_option("--threads", o.threads, "worker threads (0 = all cores)")
+      ->check(integer_in(0, kMaxThreads))->capture_default_str();
   cmd.add_option("--packets", o.packets, "rays per packet: 1 (single rays), 4, 8 or 16")
       ->check(CLI::IsMember({1, 4, 8, 16}))
       ->capture_default_str();
@@ -27,7 +89,7 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
   cmd.add_option("--top-slots", o.top_slots,
                  "bsp-top, bsp-bvh8 (and -float): largest BSP subtree (8-byte slots) under one box of the top "
                  "(default: 1024 for bsp-top, 1 for bsp-bvh8)")
-      ->check(CLI::Range(1u, 1u << 27));
+      ->check(integer_in(1, 1 << 27));
   cmd.add_option("--single-rays", o.single_rays,
                  "bsp, bsp-float, bsp-zero-eps: how single rays run: auto (interleaved for incoherent rays with tfar = inf), "
                  "sequential or interleaved; the hits are the same")
@@ -47,7 +109,8 @@ TriangleSoup load_scene(const std::string& path, bool allow_nonfinite, bool verb
                  soup.size());
     return soup;
   }
-  if (path.empty() || path == "default") {
+  if (path.empty()) throw UsageError("SCENE is an empty string: give a mesh file, or 'default' for the embedded scene");
+  if (path == "default") {
     TriangleSoup soup = make_default_scene();
     if (verbose)
       fmt::print(stderr, "scene: embedded default scene, {} triangles, {} vertices\n", soup.size(),

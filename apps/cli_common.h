@@ -29,6 +29,26 @@ struct TraceOptions {
   std::string single_rays = "auto";
 };
 
+/// Option validators with plain messages ("must be a number > 0, not 'x'"):
+/// CLI11's own print their bounds with 300 digits, let NaN through and let an
+/// unsigned option wrap "-5" around. Each parses the text as a number first.
+/// number_above(lo): a number > lo; number_at_least(lo): >= lo; number_below
+/// (hi) adds x < hi; integer_in(lo, hi): an integer in [lo, hi].
+CLI::Validator number_above(double lo);
+CLI::Validator number_at_least(double lo);
+CLI::Validator number_in_open(double lo, double hi);
+CLI::Validator integer_in(long long lo, long long hi);
+
+/// Largest ray count `gen-rays -n` writes (32 GB of rays), and largest image
+/// side of --size: past these a run fails for memory, not for a reason a
+/// message could name.
+inline constexpr long long kMaxRays = 1'000'000'000;
+inline constexpr long long kMaxImageSide = 16384;
+
+/// Throws UsageError when an option of `cmd` named in `names` was given:
+/// `why` says what they are for ("--spp is for --mode path").
+void reject_given(const CLI::App& cmd, const std::vector<std::string>& names, const std::string& why);
+
 /// Adds --accel, --tree, --threads, --packets, --membership, --top-slots,
 /// --single-rays, --allow-nonfinite to `cmd`.
 void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& default_accel);
@@ -41,9 +61,9 @@ inline constexpr const char* kSceneHelp =
     "mesh file (obj, ply, off, stl), 'default', or twin:FILE (FILE with every triangle listed twice, the copy "
     "reversed)";
 
-/// Loads SCENE, or the embedded default scene when `path` is empty or
-/// "default", or "twin:SCENE" (kTwinPrefix); prints a one-line load summary
-/// to stderr when `verbose`.
+/// Loads SCENE, or the embedded default scene when `path` is "default", or
+/// "twin:SCENE" (kTwinPrefix); prints a one-line load summary to stderr when
+/// `verbose`. An empty `path` is a UsageError (it is not "default").
 TriangleSoup load_scene(const std::string& path, bool allow_nonfinite, bool verbose);
 
 /// "area" or "closed" (BspMembership); throws UsageError otherwise.

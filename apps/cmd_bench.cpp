@@ -56,7 +56,25 @@ void print_summary(const BenchResult& r) {
   for (const std::string& n : r.notes) fmt::print("note: {}\n", n);
 }
 
+/// The output directory, made now (before any work), and the prefix a plain
+/// file name, so that no run ends on an unwritable -o or writes outside it.
+std::filesystem::path output_dir(const BenchArgs& a) {
+  if (a.prefix.empty() || a.prefix.find('/') != std::string::npos || a.prefix == "." || a.prefix == "..")
+    throw UsageError("--prefix must be a plain file name (no '/'), not '" + a.prefix + "'");
+  const std::filesystem::path dir(a.output);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw InputError(a.output, "cannot make the output directory (-o): " +
+                                   (ec ? ec.message() : std::string("a file of that name exists")));
+  return dir;
+}
+
 void run(const BenchArgs& a) {
+  for (std::size_t i = 0; i < a.modes.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (a.modes[i] == a.modes[j]) throw UsageError("--modes lists " + a.modes[i] + " twice");
+  const std::filesystem::path dir = output_dir(a);
   const auto cap = limit_threads(a.threads);
   std::vector<BenchScene> scenes;
   for (const std::string& s : a.scenes) {
@@ -74,8 +92,6 @@ void run(const BenchArgs& a) {
   };
   const BenchResult result = run_bench(scenes, o);
   if (bar) bar->finish();
-  const std::filesystem::path dir(a.output);
-  std::filesystem::create_directories(dir);
   write_file(dir / (a.prefix + ".md"), bench_markdown(result));
   write_file(dir / (a.prefix + ".csv"), bench_csv(result));
   write_file(dir / (a.prefix + ".json"), bench_json(result));
@@ -108,11 +124,16 @@ void register_bench(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--modes", args->modes, "accelerators (see --accel of trace)")->delimiter(',')->capture_default_str();
-  cmd->add_option("--count", args->count, "rays per set for speed and counters")->capture_default_str();
+  cmd->add_option("--count", args->count, "rays per set for speed and counters")
+      ->capture_default_str()->check(integer_in(1, kMaxRays));
   cmd->add_option("--error-count", args->error_count, "rays per set checked against the exact reference (0 = none)")
-      ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "worker threads for every mode (0 = all cores)")->capture_default_str();
-  cmd->add_option("--runs", args->runs, "timing rounds: each round times every mode once (single rays, then packets), and a mode's fastest round counts")->capture_default_str();
+      ->capture_default_str()->check(integer_in(0, kMaxRays));
+  cmd->add_option("--threads", args->threads, "worker threads for every mode (0 = all cores)")
+      ->check(integer_in(0, kMaxThreads))->capture_default_str();
+  cmd->add_option("--runs", args->runs,
+                  "timing rounds: each round times every mode once (single rays, then packets), and a mode's fastest "
+                  "round counts")
+      ->capture_default_str()->check(integer_in(1, 1000));
   cmd->add_option("--seed", args->seed, "ray-set seed")->capture_default_str();
   cmd->add_option("--cameras", args->cameras,
                   "camera file (e.g. bench/cameras.json): a scene it names traces its primary rays from that camera");

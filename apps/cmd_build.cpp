@@ -185,25 +185,26 @@ void register_build(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--paper", args->paper, "bsp: evaluate face/edge planes at every node (the paper's full, slow build)");
   cmd->add_option("--cost-isect", args->costs.c_isect, "bsp SAH: cost of one triangle test")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(number_above(0.0));
   cmd->add_option("--cost-kd", args->costs.c_kd, "bsp SAH: cost of a kd node")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(number_above(0.0));
   cmd->add_option("--cost-bsp-slope", args->costs.c_bsp_slope,
                   "bsp SAH: C_BSP = slope*C_isect*(N-2) + C_kd where a kd split cuts the node")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
+      ->capture_default_str()->check(number_at_least(0.0));
   cmd->add_option("--cost-bsp-fixed", args->costs.c_bsp_fixed, "bsp SAH: C_BSP where no kd split cuts the node")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(number_above(0.0));
   cmd->add_option("--empty-bonus", args->costs.empty_bonus,
                   "bsp SAH: cost factor in (0, 1] of a split with an empty child (kd-tree: 0.8; 1 = none)")
-      ->capture_default_str()->check(CLI::PositiveNumber)->check(CLI::Range(0.0, 1.0));
+      ->capture_default_str()->check(number_above(0.0))->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--min-gain", args->costs.min_gain,
                   "bsp: least expected triangle tests per ray a split must save (docs/bsp-build.md)")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
+      ->capture_default_str()->check(number_at_least(0.0));
   cmd->add_option("--min-gain-triangles", args->costs.min_gain_triangles,
                   "bsp: --min-gain limits every split of a node of at most this many triangles, in larger nodes only "
                   "splits that keep all of them in one child (docs/bsp-build.md)")
-      ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")->capture_default_str();
+      ->capture_default_str()->check(integer_in(0, 1 << 30));
+  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")
+      ->check(integer_in(0, kMaxThreads))->capture_default_str();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
   cmd->callback([args] { run_build(*args); });
 

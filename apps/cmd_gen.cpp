@@ -70,13 +70,19 @@ void register_gen(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "OBJ file to write");
   cmd->add_option("--detail", args->detail, "tessellation level of the solids, 0..4")->capture_default_str();
   cmd->add_option("--rays", args->rays,
-                  "vertex | edge | along-edge | grazing | axis-plane | axis-parallel | invalid | inside")
-      ->default_val("vertex");
+                  "with --rays-out: vertex | edge | along-edge | grazing | axis-plane | axis-parallel | invalid | inside")
+      ->default_val("vertex")
+      ->check(CLI::IsMember({"vertex", "edge", "along-edge", "grazing", "axis-plane", "axis-parallel", "invalid",
+                             "inside"}));
   cmd->add_option("--rays-out", args->rays_output, ".rays file to write");
-  cmd->add_option("-n,--count", args->count, "number of rays")->capture_default_str();
+  cmd->add_option("-n,--count", args->count, "number of rays")->capture_default_str()->check(integer_in(1, kMaxRays));
   cmd->add_option("--seed", args->seed, "random seed")->capture_default_str();
   cmd->add_flag("--list", args->list, "list the stiff scenes");
-  cmd->callback([args] { run(*args); });
+  cmd->callback([args, cmd] {
+    // Ray options without a .rays file to write would be ignored.
+    if (args->rays_output.empty()) reject_given(*cmd, {"--rays", "--count", "--seed"}, "ray options need --rays-out");
+    run(*args);
+  });
 }
 
 }  // namespace bsprt::cli

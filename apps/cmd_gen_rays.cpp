@@ -22,14 +22,17 @@ struct GenRaysArgs {
   std::vector<int> size;
   std::string camera;  ///< primary rays: --camera FILE[:NAME] instead of framing the scene
   bool allow_nonfinite = false;
+  bool count_given = false;  ///< -n was on the command line
 };
 
 void run(const GenRaysArgs& a) {
-  const TriangleSoup soup = load_scene(a.scene, a.allow_nonfinite, true);
   const RaySetKind kind = parse_ray_set(a.kind);
+  if (kind != RaySetKind::Primary && (!a.camera.empty() || !a.size.empty()))
+    throw UsageError(std::string(!a.camera.empty() ? "--camera" : "--size") + " is for --kind primary, not " + a.kind);
+  if (!a.size.empty() && a.count_given)
+    throw UsageError("-n and --size both set the number of primary rays: give one");
+  const TriangleSoup soup = load_scene(a.scene, a.allow_nonfinite, true);
   std::vector<Ray> rays;
-  if (!a.camera.empty() && kind != RaySetKind::Primary)
-    throw UsageError("--camera is for --kind primary, not " + a.kind);
   if (kind == RaySetKind::Primary && (!a.size.empty() || !a.camera.empty())) {
     const bool is_default = a.scene.empty() || a.scene == "default";
     const Camera cam = !a.camera.empty() ? camera_from_spec(a.camera).camera
@@ -52,12 +55,17 @@ void register_gen_rays(CLI::App& app) {
   cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
   cmd->add_option("-o,--output", args->output, ".rays file to write")->required();
   cmd->add_option("--kind", args->kind, "primary | random | vertex | edge")->capture_default_str();
-  cmd->add_option("-n,--count", args->count, "number of rays (primary: about n pixels, square)")->capture_default_str();
+  cmd->add_option("-n,--count", args->count, "number of rays (primary: about n pixels, square)")
+      ->capture_default_str()->check(integer_in(1, kMaxRays));
   cmd->add_option("--camera", args->camera, "primary rays: camera file FILE or FILE:NAME (docs/rendering.md)");
-  cmd->add_option("--size", args->size, "primary rays: image width and height (camera frames the scene)")->expected(2);
+  cmd->add_option("--size", args->size, "primary rays: image width and height (camera frames the scene)")
+      ->expected(2)->check(integer_in(1, kMaxImageSide));
   cmd->add_option("--seed", args->seed, "random seed")->capture_default_str();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
-  cmd->callback([args] { run(*args); });
+  cmd->callback([args, cmd] {
+    args->count_given = cmd->count("--count") > 0;
+    run(*args);
+  });
 }
 
 }  // namespace bsprt::cli

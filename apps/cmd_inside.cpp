@@ -2,15 +2,20 @@
 // closed mesh, for each point of a text file, exactly (robust/inside_query.h).
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <charconv>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <system_error>
 #include <vector>
 
 #include "apps/cli_common.h"
 #include "apps/progress.h"
 #include "bsprt/error.h"
+#include "geometry/core/read_file.h"
 #include "robust/inside_query.h"
 
 namespace bsprt::cli {
@@ -21,30 +26,66 @@ struct InsideArgs {
   bool allow_nonfinite = false;
 };
 
-/// Points from a text file: "x y z" per line; empty lines and lines starting
-/// with '#' are skipped. A line that is not three numbers is an InputError
+/// The points of a points file, and how many of them were rounded.
+struct Points {
+  std::vector<Vec3f> at;
+  std::size_t rounded = 0;  ///< points with a coordinate that is not a float, read as the nearest one
+};
+
+/// `line` with bytes that would garble a terminal (NUL, control characters)
+/// shown as '?', for messages.
+std::string printable(const std::string& line) {
+  std::string out = line;
+  for (char& ch : out)
+    if (static_cast<unsigned char>(ch) < 0x20 && ch != '\t') ch = '?';
+  return out;
+}
+
+/// Points from a text file: "x y z" per line; empty lines and '#' comments
+/// (a whole line, or the rest of one) are skipped. A coordinate is read as a
+/// double and rounded to the nearest float, as mesh coordinates are (the
+/// query is exact on float points; docs/exact-leaf-test.md, "Inside
+/// queries"): the rounded points are counted. A line that is not three
+/// numbers, a number that is not finite or overflows float, is an InputError
 /// naming the file and line.
-std::vector<Vec3f> read_points(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open");
-  std::vector<Vec3f> points;
-  std::string line;
-  for (std::size_t n = 1; std::getline(in, line); ++n) {
-    const std::size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream s(line);
+Points read_points(const std::string& path) {
+  const std::string text = read_file_bytes(path, "points file");
+  Points points;
+  std::size_t n = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string line = text.substr(at, end - at);
+    at = end + 1;
+    ++n;
+    const std::string data = line.substr(0, line.find('#'));
+    std::istringstream s(data);
+    std::string word[3], rest;
+    if (data.find_first_not_of(" \t\r") == std::string::npos) continue;
+    if (!(s >> word[0] >> word[1] >> word[2]) || (s >> rest))
+      throw InputError(path, std::int64_t(n), "expected three numbers \"x y z\", got \"" + printable(line) + "\"");
     Vec3f p;
-    std::string rest;
-    if (!(s >> p.x >> p.y >> p.z) || (s >> rest))
-      throw InputError(path + ":" + std::to_string(n), "expected three numbers \"x y z\", got \"" + line + "\"");
-    points.push_back(p);
+    bool rounded = false;
+    for (int k = 0; k < 3; ++k) {
+      double v = 0.0;
+      const auto [ptr, ec] = std::from_chars(word[k].data(), word[k].data() + word[k].size(), v);
+      if (ec == std::errc::result_out_of_range || (ec == std::errc{} && std::isfinite(v) && !std::isfinite(float(v))))
+        throw InputError(path, std::int64_t(n), "\"" + printable(word[k]) + "\" overflows float (points are float)");
+      if (ec != std::errc{} || ptr != word[k].data() + word[k].size())
+        throw InputError(path, std::int64_t(n), "\"" + printable(word[k]) + "\" is not a number");
+      if (!std::isfinite(v)) throw InputError(path, std::int64_t(n), "\"" + printable(word[k]) + "\" is not finite");
+      p[k] = float(v);
+      rounded = rounded || double(p[k]) != v;
+    }
+    points.at.push_back(p);
+    points.rounded += rounded;
   }
   return points;
 }
 
 void run(const InsideArgs& a) {
   const TriangleSoup soup = load_scene(a.scene, a.allow_nonfinite, true);
-  const std::vector<Vec3f> points = read_points(a.points);
+  const Points read = read_points(a.points);
+  const std::vector<Vec3f>& points = read.at;
   if (const std::size_t bad = open_or_inconsistent_edges(soup))
     fmt::print(stderr,
                "warning: {} edges of the mesh are open, non-manifold or inconsistently oriented: inside and "
@@ -70,9 +111,13 @@ void run(const InsideArgs& a) {
     ++count[int(side)];
   }
   if (!out) throw InputError(a.output, "write failed");
-  fmt::print("{} points: {} inside, {} outside, {} on the surface ({:.3f} s; {:.2f} candidate triangles and {:.4f} "
+  fmt::print("{} points{}: {} inside, {} outside, {} on the surface ({:.3f} s; {:.2f} candidate triangles and {:.4f} "
              "exact decisions per point); wrote {}\n",
-             points.size(), count[int(PointSide::Inside)], count[int(PointSide::Outside)],
+             points.size(),
+             read.rounded ? fmt::format(" ({} with a coordinate rounded to the nearest float, as mesh coordinates are)",
+                                        read.rounded)
+                          : std::string(),
+             count[int(PointSide::Inside)], count[int(PointSide::Outside)],
              count[int(PointSide::OnSurface)], s, points.empty() ? 0.0 : double(c.triangle_tests) / points.size(),
              points.empty() ? 0.0 : double(c.exact_decisions) / points.size(), a.output);
 }
@@ -84,9 +129,9 @@ void register_inside(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "inside", "inside, outside or on the surface of a closed mesh, exactly, for each point of a text file");
   cmd->add_option("SCENE", args->scene, "closed mesh file or 'default'")->required();
-  cmd->add_option("POINTS", args->points, "text file: one point \"x y z\" per line ('#' comments)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  cmd->add_option("POINTS", args->points,
+                  "text file: one point \"x y z\" per line ('#' comments), each coordinate read as the nearest float")
+      ->required();
   cmd->add_option("-o,--output", args->output, "text file: inside, outside or surface, a line per point")->required();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
   cmd->callback([args] { run(*args); });

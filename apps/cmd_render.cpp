@@ -3,6 +3,7 @@
 // accelerator (the embedded default scene when none is given).
 #include <fmt/core.h>
 
+#include <filesystem>
 #include <fstream>
 #include <memory>
 
@@ -19,7 +20,7 @@ namespace bsprt::cli {
 namespace {
 
 struct RenderArgs {
-  std::string scene, output = "bsprt.png", mode = "cast", json;
+  std::string scene = "default", output = "bsprt.png", mode = "cast", json;
   TraceOptions trace;
   std::vector<int> size{800, 600};
   std::vector<float> vp, vi, vu;
@@ -35,20 +36,44 @@ struct RenderArgs {
 Vec3f to_vec(const std::vector<float>& v) { return {v[0], v[1], v[2]}; }
 
 Camera pick_camera(const RenderArgs& a, const TriangleSoup& soup) {
-  const bool is_default = a.scene.empty() || a.scene == "default";
-  Camera cam = !a.camera.empty() ? camera_from_spec(a.camera).camera
-               : is_default       ? default_scene_camera()
-                                  : frame_bounds(soup.bounds());
+  const bool is_default = a.scene == "default";
+  const bool placed = !a.vp.empty() && !a.vi.empty();  // the options alone place the camera: no framing
+  Camera cam;
+  if (!a.camera.empty()) {
+    const NamedCamera named = camera_from_spec(a.camera);
+    const std::string file = std::filesystem::path(a.scene).filename().string();
+    if (!named.scene.empty() && named.scene != file)
+      fmt::print(stderr, "render: warning: camera '{}' is for {}, not {}\n", named.name, named.scene,
+                 is_default ? "the default scene" : file);
+    cam = named.camera;
+  } else if (is_default) {
+    cam = default_scene_camera();
+  } else if (placed) {
+    cam.fov = 45.0f;  // frame_bounds' field of view
+  } else {
+    cam = frame_bounds(soup.bounds());
+  }
   if (!a.vp.empty()) cam.vp = to_vec(a.vp);
   if (!a.vi.empty()) cam.vi = to_vec(a.vi);
   if (!a.vu.empty()) cam.vu = to_vec(a.vu);
   if (a.fov > 0) cam.fov = a.fov;
+  if (const std::string problem = camera_problem(cam); !problem.empty())
+    throw UsageError("the camera cannot see anything: " + problem);
   return cam;
 }
 
+/// .png or .pfm, by the extension of `path` (checked before any work, check_output).
 void write_image(const std::string& path, const Image& image) {
   if (path.size() > 4 && path.substr(path.size() - 4) == ".pfm") write_pfm(path, image);
   else write_png(path, image);
+}
+
+/// The image file must end in .png or .pfm, the two formats render writes.
+void check_output(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext != ".png" && ext != ".pfm")
+    throw UsageError("-o " + path + ": render writes .png or .pfm images, not '" +
+                     (ext.empty() ? "(no extension)" : ext) + "'");
 }
 
 std::uint64_t tile_count(int w, int h) { return std::uint64_t((w + 15) / 16) * std::uint64_t((h + 15) / 16); }
@@ -111,7 +136,12 @@ void run_path(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup
     json += "}";
   }
   json += "]}\n";
-  if (!a.json.empty()) std::ofstream(a.json) << json;
+  if (!a.json.empty()) {
+    std::ofstream f(a.json);
+    f << json;
+    f.close();
+    if (!f) throw InputError(a.json, "cannot write the --json summary");
+  }
 }
 
 void run_heat(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup& soup, const RenderOptions& options) {
@@ -138,18 +168,18 @@ void run_heat(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup
 }
 
 void run(const RenderArgs& a) {
+  check_output(a.output);
   const auto threads = limit_threads(a.trace.threads);
   const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, true);
-  const std::unique_ptr<Accelerator> tracer = make_accel(a.trace, soup);
   RenderOptions options;
+  options.camera = pick_camera(a, soup);  // before the build: a camera that sees nothing is refused at once
+  const std::unique_ptr<Accelerator> tracer = make_accel(a.trace, soup);
   options.width = a.size[0];
   options.height = a.size[1];
-  options.camera = pick_camera(a, soup);
   options.packet_width = a.trace.packets;
   if (a.mode == "cast") return run_cast(a, *tracer, soup, options);
   if (a.mode == "path") return run_path(a, *tracer, soup, options);
-  if (a.mode == "heat") return run_heat(a, *tracer, soup, options);
-  throw UsageError("--mode must be cast, path or heat, not '" + a.mode + "'");
+  return run_heat(a, *tracer, soup, options);  // --mode is checked by its option
 }
 
 }  // namespace
@@ -160,18 +190,19 @@ void register_render(CLI::App& app) {
   cmd->add_option("SCENE", args->scene, std::string(kSceneHelp) + "; omit for the default scene");
   cmd->add_option("-o,--output", args->output, "image to write (.png, or .pfm for raw radiance)")->capture_default_str();
   cmd->add_option("--mode", args->mode, "cast (eye light, packets) | path (path tracing) | heat (cost per pixel)")
-      ->capture_default_str();
-  cmd->add_option("--size", args->size, "image width and height")->expected(2)->capture_default_str();
+      ->capture_default_str()->check(CLI::IsMember({"cast", "path", "heat"}));
+  cmd->add_option("--size", args->size, "image width and height")
+      ->expected(2)->capture_default_str()->check(integer_in(1, kMaxImageSide));
   cmd->add_option("--vp", args->vp, "camera position X Y Z")->expected(3);
   cmd->add_option("--vi", args->vi, "camera look-at point X Y Z")->expected(3);
   cmd->add_option("--vu", args->vu, "camera up vector X Y Z")->expected(3);
-  cmd->add_option("--fov", args->fov, "vertical field of view in degrees");
+  cmd->add_option("--fov", args->fov, "vertical field of view in degrees, in (0, 180)")->check(number_in_open(0, 180));
   cmd->add_option("--camera", args->camera,
                   "camera file (docs/rendering.md), FILE or FILE:NAME, e.g. bench/cameras.json:sponza-atrium; "
                   "--vp/--vi/--vu/--fov override its fields");
   cmd->add_flag("--stats", args->stats, "cast: count and print node visits and triangle tests per ray; path: the same per bounce, also "
                 "in --json (the timings then include the counting)");
-  cmd->add_option("--spp", args->spp, "path: samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--spp", args->spp, "path: samples per pixel")->capture_default_str()->check(integer_in(1, 1 << 20));
   cmd->add_option("--bounces", args->bounces, "path: indirect bounces (0 = direct light)")->capture_default_str()
       ->check(CLI::Range(0, 64));
   cmd->add_option("--seed", args->seed, "path: random seed (images are identical for any thread count)")
@@ -179,9 +210,16 @@ void register_render(CLI::App& app) {
   cmd->add_option("--json", args->json, "path: write a JSON summary (rays, Mrays/s by bounce) to this file");
   cmd->add_option("--heat-metric", args->heat_metric, "heat: time | nodes | tests")->capture_default_str();
   cmd->add_option("--heat-compare", args->heat_compare, "heat: draw the difference to this accelerator's map");
-  cmd->add_option("--heat-max", args->heat_max, "heat: top of the colour scale (0 = the image's maximum)");
+  cmd->add_option("--heat-max", args->heat_max, "heat: top of the colour scale (0 = the image's maximum)")
+      ->check(number_at_least(0.0));
   add_trace_options(*cmd, args->trace, "bsp");
-  cmd->callback([args] { run(*args); });
+  cmd->callback([args, cmd] {
+    // Options of one mode given with another would be ignored: refuse them.
+    if (args->mode != "path") reject_given(*cmd, {"--spp", "--bounces", "--seed", "--json"}, "for --mode path only");
+    if (args->mode != "heat")
+      reject_given(*cmd, {"--heat-metric", "--heat-compare", "--heat-max"}, "for --mode heat only");
+    run(*args);
+  });
 }
 
 }  // namespace bsprt::cli

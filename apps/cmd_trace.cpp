@@ -73,6 +73,12 @@ void run_all_hits(const TraceArgs& a) {
     }
   if (!out) throw InputError(a.hits, "write failed");
   const RayCounters c = counters.combine([](RayCounters x, const RayCounters& y) { return x += y; });
+  if (a.json) {
+    fmt::print("{{\"all_hits\": true, \"rays\": {}, \"crossings\": {}, \"seconds\": {:.6f}, "
+               "\"exact_decisions_per_ray\": {:.6f}}}\n",
+               rays.size(), total, s, rays.empty() ? 0.0 : double(c.exact_decisions) / double(rays.size()));
+    return;
+  }
   fmt::print("all hits: {} rays, {} crossings ({:.3f} per ray), {:.3f} s, {:.4f} exact decisions per ray; wrote {}\n",
              rays.size(), total, rays.empty() ? 0.0 : double(total) / double(rays.size()), s,
              rays.empty() ? 0.0 : double(c.exact_decisions) / double(rays.size()), a.hits);
@@ -236,10 +242,13 @@ void register_trace(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print one JSON object instead of text");
   cmd->add_flag("--stats", args->stats, "count and print node visits and triangle tests per ray");
   cmd->add_option("--passes", args->passes, "timing passes over the rays; the fastest is reported (hits are the same each pass)")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(integer_in(1, 1000));
   cmd->add_flag("--face-hits", args->face_hits,
                 "bsp: count hits that a split on the hit triangle's own face plane proves (needs --tree)");
   cmd->callback([args, cmd] {
+    if (args->all_hits)  // exact crossings from the exact reference: no accelerator, one untimed pass
+      reject_given(*cmd, {"--packets", "--passes", "--single-rays", "--membership", "--top-slots"},
+                   "not used by --all-hits, which decides every crossing exactly from the exact reference's tree");
     args->accel_given = cmd->count("--accel") > 0;
     args->tree_given = cmd->count("--tree") > 0;
     run(*args);

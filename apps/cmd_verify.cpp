@@ -92,7 +92,8 @@ void register_verify(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("verify", "prove a BSP (or kd) tree file correct for a scene (exact, independent of the builder)");
   cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
   cmd->add_option("TREE", args->tree, "tree file (bsprt build --accel bsp|kd -o TREE)")->required();
-  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
+  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")
+      ->check(integer_in(0, kMaxThreads));
   cmd->add_flag("--strict", args->strict, "fail on listed triangles that do not touch the leaf's cell");
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (degenerate)");
   cmd->callback([args] { run(*args); });

@@ -230,8 +230,13 @@ std::vector<std::string> accel_names() {
 std::unique_ptr<Accelerator> make_tracer(const std::string& accel, const TriangleSoup& soup,
                                          const AccelOptions& options) {
   const AccelInfo& info = accel_info(accel);
-  if (options.has_tree() && info.tree == AccelTree::None)
-    throw UsageError("--tree works with --accel kd or bsp, not '" + accel + "'");
+  check_threads(options.threads, "threads");
+  if (options.has_tree() && info.tree == AccelTree::None) {
+    std::string with_tree;  // every accelerator that reads a kd or BSP tree file
+    for (const std::string& name : accel_names())
+      if (accel_info(name).tree != AccelTree::None) with_tree += (with_tree.empty() ? "" : ", ") + name;
+    throw UsageError("a tree file works with the accelerators " + with_tree + ", not '" + accel + "'");
+  }
   return info.make(soup, options);
 }
 

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <iterator>
 
+#include "geometry/core/read_file.h"
+
 namespace bsprt {
 namespace {
 
@@ -35,10 +37,7 @@ T get(const std::vector<std::byte>& in, std::size_t at) {
 }  // namespace
 
 std::vector<std::byte> read_tree_file_image(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open tree file");
-  std::vector<char> chars((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path, "cannot read tree file");
+  const std::string chars = read_file_bytes(path, "tree file");
   std::vector<std::byte> bytes(chars.size());
   if (!chars.empty()) std::memcpy(bytes.data(), chars.data(), chars.size());
   return bytes;

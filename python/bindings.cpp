@@ -4,8 +4,9 @@
 /// contiguity) and turned into ValueError; rays and hits cross without copies
 /// (N x 8 float32 rays = the .rays record, structured hits = the .hits record);
 /// face indices are widened and range-checked (one copy, 12 bytes a triangle).
-/// The GIL is released while building, verifying and tracing. python/bsprt/__init__.py
-/// adds the friendly signatures.
+/// The GIL is released while loading, saving, building, verifying, tracing
+/// and comparing. Paths are str or os.PathLike. python/bsprt/__init__.py adds
+/// the friendly signatures.
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -13,6 +14,7 @@
 
 #include <atomic>
 #include <cstring>
+#include <optional>
 
 #include "bsprt/bsprt.h"
 
@@ -38,6 +40,17 @@ void require(const py::array& a, const char* what, py::ssize_t cols) {
                           ", got " + std::string(py::str(py::tuple(py::cast(std::vector<py::ssize_t>(a.shape(), a.shape() + a.ndim()))))));
   if (!(a.flags() & py::array::c_style))
     throw py::value_error(std::string(what) + ": must be C-contiguous (numpy.ascontiguousarray)");
+}
+
+/// A path argument (str, bytes or os.PathLike, through os.fspath) as a
+/// string; TypeError for anything else, ValueError for an embedded NUL, as
+/// Python's open() does.
+std::string path_of(const py::object& p) {
+  const py::object fs = py::module_::import("os").attr("fspath")(p);
+  const std::string s = py::isinstance<py::bytes>(fs) ? std::string(fs.cast<py::bytes>()) : fs.cast<std::string>();
+  if (s.find('\0') != std::string::npos)
+    throw py::value_error("path contains a NUL character: " + std::string(s.c_str()));
+  return s;
 }
 
 std::span<const Ray> rays_of(const py::array& rays) {
@@ -90,6 +103,7 @@ py::dict comparison_dict(const bsprt::HitComparison& c) {
   d["rays"] = c.rays;
   d["both_miss"] = c.both_miss;
   d["same_triangle"] = c.same_triangle;
+  d["t_off"] = c.t_off;
   d["tie"] = c.tie;
   d["lost"] = c.lost;
   d["extra"] = c.extra;
@@ -125,17 +139,21 @@ bsprt::Tree build(const bsprt::Scene& scene, const std::string& accel, int threa
     };
     o.cancel = [failed] { return failed->load(); };
   }
+  std::optional<bsprt::Tree> tree;
   try {
     py::gil_scoped_release release;
-    return bsprt::build(scene, o);
+    tree = bsprt::build(scene, o);
   } catch (const bsprt::Cancelled&) {
-    if (*error) {
-      py::gil_scoped_acquire gil;
-      PyErr_SetObject(PyObject_Type(error->ptr()), error->ptr());
-      throw py::error_already_set();
-    }
-    throw;
+    if (!*error) throw;
   }
+  // The GIL is held again. A callback that raised stopped the build, or, on
+  // the last report (total, total), after which nothing polls cancel, let it
+  // finish: either way its exception is raised, as docs/api.md promises.
+  if (*error) {
+    PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(error->ptr())), error->ptr());
+    throw py::error_already_set();
+  }
+  return std::move(*tree);
 }
 
 /// Scene(vertices, faces): vertices (V, 3) float32, faces (F, 3) of any integer
@@ -150,18 +168,29 @@ bsprt::Scene scene_from_arrays(const py::array& vertices, const py::array& faces
     throw py::value_error("faces: expected an integer dtype, got " + std::string(py::str(faces.dtype())));
   if (faces.ndim() != 2 || faces.shape(1) != 3) throw py::value_error("faces: expected shape (F, 3)");
   const auto v = py::array_t<float, py::array::c_style>::ensure(vertices);
-  const auto f = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(faces);
-  std::vector<std::uint32_t> idx(std::size_t(f.size()));
-  const std::int64_t* fi = f.data();
   const std::int64_t nv = vertices.shape(0);
-  for (std::size_t i = 0; i < idx.size(); ++i) {
-    if (fi[i] < 0 || fi[i] >= nv)
-      throw py::value_error("faces: triangle " + std::to_string(i / 3) + " corner " + std::to_string(i % 3) +
-                            " is vertex " + std::to_string(fi[i]) + ", out of range [0, " + std::to_string(nv) + ")");
-    idx[i] = std::uint32_t(fi[i]);
+  std::vector<std::uint32_t> idx;
+  // Widened to 64 bits of the faces' own signedness, so that no index wraps
+  // around (a uint64 2^64 - 1 is not vertex -1) before the range check.
+  const auto check = [&](const auto* fi, std::size_t n) {
+    idx.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (fi[i] < 0 || std::uint64_t(fi[i]) >= std::uint64_t(nv))
+        throw py::value_error("faces: triangle " + std::to_string(i / 3) + " corner " + std::to_string(i % 3) +
+                              " is vertex " + std::to_string(fi[i]) + ", out of range [0, " + std::to_string(nv) + ")");
+      idx[i] = std::uint32_t(fi[i]);
+    }
+  };
+  if (kind == 'u') {
+    const auto f = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(faces);
+    check(f.data(), std::size_t(f.size()));
+  } else {
+    const auto f = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(faces);
+    check(f.data(), std::size_t(f.size()));
   }
   bsprt::SceneOptions o;
   o.allow_nonfinite = allow_nonfinite;
+  py::gil_scoped_release release;  // the exact degeneracy test of every triangle
   return bsprt::Scene::from_arrays({v.data(), std::size_t(v.size())}, idx, o);
 }
 
@@ -180,11 +209,12 @@ PYBIND11_MODULE(_bsprt, m) {
            "vertices: (V, 3) float32; faces: (F, 3) integer vertex indices, 0-based.")
       .def_static(
           "load",
-          [](const std::string& path, bool allow_nonfinite) {
+          [](const py::object& path, bool allow_nonfinite) {
+            const std::string p = path_of(path);
             bsprt::SceneOptions o;
             o.allow_nonfinite = allow_nonfinite;
             py::gil_scoped_release release;
-            return bsprt::Scene::load(path, o);
+            return bsprt::Scene::load(p, o);
           },
           py::arg("path"), py::arg("allow_nonfinite") = false,
           "Loads an OBJ, PLY, OFF or STL file (every face kept), or 'default' for the embedded scene.")
@@ -230,16 +260,39 @@ PYBIND11_MODULE(_bsprt, m) {
           "Exact, independent certificate of a tree (what `bsprt verify` prints).");
 
   py::class_<bsprt::Tree>(m, "Tree")
-      .def_static("load", &bsprt::Tree::load, py::arg("path"), py::arg("scene"))
-      .def("save", &bsprt::Tree::save, py::arg("path"))
+      .def_static(
+          "load",
+          [](const py::object& path, const bsprt::Scene& scene) {
+            const std::string p = path_of(path);
+            py::gil_scoped_release release;
+            return bsprt::Tree::load(p, scene);
+          },
+          py::arg("path"), py::arg("scene"))
+      .def(
+          "save",
+          [](const bsprt::Tree& t, const py::object& path) {
+            const std::string p = path_of(path);
+            py::gil_scoped_release release;
+            t.save(p);
+          },
+          py::arg("path"))
       .def_property_readonly("kind", [](const bsprt::Tree& t) { return t.kind() == bsprt::TreeKind::Kd ? "kd" : "bsp"; })
       .def_property_readonly("build_seconds", &bsprt::Tree::build_seconds)
       .def_property_readonly("nbytes", [](const bsprt::Tree& t) { return t.bytes().size(); });
 
   py::class_<bsprt::Tracer>(m, "_Tracer")
-      .def(py::init<const bsprt::Scene&, const bsprt::Tree&, std::string_view>(), py::arg("scene"), py::arg("tree"),
-           py::arg("mode") = "certified", py::keep_alive<1, 2>())
-      .def_static("by_name", &bsprt::Tracer::by_name, py::arg("scene"), py::arg("accel"))
+      .def(py::init([](const bsprt::Scene& scene, const bsprt::Tree& tree, const std::string& mode) {
+             py::gil_scoped_release release;  // flattening or loading the tree
+             return bsprt::Tracer(scene, tree, mode);
+           }),
+           py::arg("scene"), py::arg("tree"), py::arg("mode") = "certified", py::keep_alive<1, 2>())
+      .def_static(
+          "by_name",
+          [](const bsprt::Scene& scene, const std::string& accel) {
+            py::gil_scoped_release release;  // builds the accelerator in memory
+            return bsprt::Tracer::by_name(scene, accel);
+          },
+          py::arg("scene"), py::arg("accel"))
       .def_static("accelerators", &bsprt::Tracer::accelerators)
       .def_property_readonly("name", &bsprt::Tracer::name)
       .def_property_readonly("certified", &bsprt::Tracer::certified)
@@ -273,32 +326,60 @@ PYBIND11_MODULE(_bsprt, m) {
 
   m.def(
       "read_rays",
-      [](const std::string& path) {
-        const std::vector<Ray> rays = bsprt::read_rays(path);
+      [](const py::object& path) {
+        const std::string p = path_of(path);
+        std::vector<Ray> rays;
+        {
+          py::gil_scoped_release release;
+          rays = bsprt::read_rays(p);
+        }
         py::array_t<float> a(std::vector<py::ssize_t>{py::ssize_t(rays.size()), 8});
         if (!rays.empty()) std::memcpy(a.mutable_data(), rays.data(), rays.size() * sizeof(Ray));
         return a;
       },
       py::arg("path"), "Reads a .rays file as an (N, 8) float32 array: org, tnear, dir, tfar.");
   m.def(
-      "write_rays", [](const std::string& path, const py::array& rays) { bsprt::write_rays(path, rays_of(rays)); },
+      "write_rays",
+      [](const py::object& path, const py::array& rays) {
+        const std::string p = path_of(path);
+        const std::span<const Ray> r = rays_of(rays);
+        py::gil_scoped_release release;
+        bsprt::write_rays(p, r);
+      },
       py::arg("path"), py::arg("rays"));
   m.def(
       "read_hits",
-      [](const std::string& path) {
-        const std::vector<Hit> hits = bsprt::read_hits(path);
+      [](const py::object& path) {
+        const std::string p = path_of(path);
+        std::vector<Hit> hits;
+        {
+          py::gil_scoped_release release;
+          hits = bsprt::read_hits(p);
+        }
         py::array a = new_hits(hits.size());
         if (!hits.empty()) std::memcpy(a.mutable_data(), hits.data(), hits.size() * sizeof(Hit));
         return a;
       },
       py::arg("path"), "Reads a .hits file as a structured array of HIT_DTYPE records.");
   m.def(
-      "write_hits", [](const std::string& path, const py::array& hits) { bsprt::write_hits(path, hits_of(hits, "hits")); },
+      "write_hits",
+      [](const py::object& path, const py::array& hits) {
+        const std::string p = path_of(path);
+        const std::span<const Hit> h = hits_of(hits, "hits");
+        py::gil_scoped_release release;
+        bsprt::write_hits(p, h);
+      },
       py::arg("path"), py::arg("hits"));
   m.def(
       "compare",
       [](const py::array& reference, const py::array& tested, double rel_tol) {
-        return comparison_dict(bsprt::compare_hits(hits_of(reference, "reference"), hits_of(tested, "tested"), rel_tol));
+        const std::span<const Hit> r = hits_of(reference, "reference"), t = hits_of(tested, "tested");
+        bsprt::HitComparison c;
+        {
+          py::gil_scoped_release release;
+          c = bsprt::compare_hits(r, t, rel_tol);
+        }
+        return comparison_dict(c);
       },
       py::arg("reference"), py::arg("tested"), py::arg("rel_tol") = 1e-5,
       "Ray-by-ray comparison, the vocabulary of `bsprt compare`.");

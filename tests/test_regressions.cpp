@@ -3,14 +3,24 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <utility>
+#include <vector>
 
 #include "geometry/scenes/default_scene.h"
 #include "bsprt/error.h"
 #include "geometry/io/load_mesh.h"
 #include "builder/accel_factory.h"
+#include "builder/bsp/bsp_build.h"
+#include "builder/bsp/bsp_flat_io.h"
+#include "builder/bsp/bsp_flatten.h"
+#include "builder/kd/kd_build.h"
+#include "builder/kd/kd_file.h"
+#include "builder/tree_file.h"
+#include "verify/verify_file.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 #include "traverse/brute_force.h"
@@ -225,5 +235,136 @@ TEST_CASE("exact reference: a segment at +inf or at -inf holds no hit, in every 
     r.dir = {0, 0, -1};  // the plane behind the origin, at t = -1: in [-inf, +inf]
     r.tfar = inf;
     CHECK(t->trace(r).prim == 0);
+  }
+}
+
+namespace {
+/// The bytes of tree file `path` with the 4-byte field at `offset` of section
+/// `tag` set to `value`, and the CRC recomputed: a file that passes every
+/// container check, as an edit (or a bug) could leave it.
+void patch_tree_file(const std::string& path, std::uint32_t tag, std::size_t offset, std::uint32_t value) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> c((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::byte> bytes(c.size());
+  std::memcpy(bytes.data(), c.data(), c.size());
+  std::size_t at = 40;  // sections: tag, reserved, size (16 bytes), data padded to 8
+  bool found = false;
+  while (at + 16 <= bytes.size()) {
+    std::uint32_t t;
+    std::uint64_t size;
+    std::memcpy(&t, &bytes[at], 4);
+    std::memcpy(&size, &bytes[at + 8], 8);
+    if (t == tag) {
+      std::memcpy(&bytes[at + 16 + offset], &value, 4);
+      found = true;
+      break;
+    }
+    at = (at + 16 + size + 7) & ~std::size_t(7);
+  }
+  REQUIRE(found);
+  std::uint32_t version;
+  std::memcpy(&version, &bytes[8], 4);
+  const std::uint32_t crc = tree_file_crc(bytes, version);
+  std::memcpy(&bytes[36], &crc, 4);
+  std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(bytes.data()),
+                                                                std::streamsize(bytes.size()));
+}
+}  // namespace
+
+// Found by an adversarial review (2026-12-07): a kd tree file whose root box
+// (KBND) had been shrunk, with its CRC recomputed, loaded and traced without
+// an error while every hit was lost, and `bsprt verify` certified it, because
+// the coverage check clipped each triangle to the root box first; NaN bounds
+// made verify die of SIGFPE. The flat BSP sections (FHDR) had the same hole in
+// the loader (verify caught it there), and verify accepted a flat layout
+// version that no traversal can load.
+TEST_CASE("tree file: a root box that leaves out a triangle is refused by the loaders and by verify",
+          "[regression]") {
+  // The cube: its kd-tree and its BSP are single leaves, so no split falls
+  // outside a shrunk box and only the box check can see it (the review's case).
+  const TriangleSoup soup = load_mesh(bsprt::test::scene_path("cube.obj"));
+  const std::string kd_path = bsprt::test::temp_path("regression_kd_box.kd");
+  const KdTree kd = build_kd(soup);
+  REQUIRE(kd.nodes.size() == 1);
+  REQUIRE_NOTHROW(validate_kd_coverage(kd, soup));
+  KdTree small = kd;
+  small.bounds.lo = {-0.01f, -0.01f, -0.01f};
+  small.bounds.hi = {0.01f, 0.01f, 0.01f};
+  CHECK_THROWS_WITH(validate_kd_coverage(small, soup), Catch::Contains("sticks out of the root box"));
+  write_kd_tree(kd_path, small, soup);
+  CHECK_THROWS_WITH(read_kd_tree(kd_path, soup), Catch::Contains("kd-tree root box does not contain triangle"));
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    KdTree b = kd;
+    b.bounds.lo.y = bad;
+    write_kd_tree(kd_path, b, soup);
+    CHECK_THROWS_WITH(read_kd_tree(kd_path, soup), Catch::Contains("kd-tree root box is not finite, or inverted"));
+  }
+  write_kd_tree(kd_path, kd, soup);
+  REQUIRE_NOTHROW(read_kd_tree(kd_path, soup));
+
+  const std::string bsp_path = bsprt::test::temp_path("regression_flat_box.bsp");
+  const BspTree exact = build_bsp(soup);
+  const FlatBspTree good = flatten_bsp(soup, exact);
+  FlatBspTree flat = good;
+  write_bsp_file_with_flat(bsp_path, soup, exact, flat);
+  REQUIRE_NOTHROW(read_flat_bsp_sections(TreeFileReader(bsp_path), soup));
+  flat.bounds.hi.x = 0.0f;  // half the cube
+  write_bsp_file_with_flat(bsp_path, soup, exact, flat);
+  CHECK_THROWS_WITH(read_flat_bsp_sections(TreeFileReader(bsp_path), soup),
+                    Catch::Contains("flat BSP root box does not contain triangle"));
+  // FHDR: root_lo[3], root_hi[3], then the layout version at byte 24.
+  write_bsp_file_with_flat(bsp_path, soup, exact, good);
+  patch_tree_file(bsp_path, kFlatBspHeaderTag, 24, 9);
+  CHECK_THROWS_WITH(read_flat_bsp_sections(TreeFileReader(bsp_path), soup), Catch::Contains("layout version 9"));
+  CHECK_THROWS_WITH(read_verify_input(bsp_path, soup), Catch::Contains("layout version 9"));
+}
+
+// Found by an adversarial review (2026-12-07): `--threads 70000` (and the
+// same in the library) crashed inside oneTBB, whose arenas fail above 65535.
+TEST_CASE("threads: counts outside [0, kMaxThreads] are a UsageError in every entry point", "[regression]") {
+  const TriangleSoup soup = make_default_scene();
+  for (const int bad : {-1, kMaxThreads + 1, 70000}) {
+    CAPTURE(bad);
+    AccelOptions o;
+    o.threads = bad;
+    CHECK_THROWS_AS(make_tracer("bsp", soup, o), UsageError);
+    BspConfig c;
+    c.threads = bad;
+    CHECK_THROWS_AS(build_bsp(soup, c), UsageError);
+  }
+  AccelOptions ok;
+  ok.threads = kMaxThreads;  // allowed (an arena of at most that many threads)
+  CHECK_NOTHROW(make_tracer("kd", soup, ok));
+}
+
+// Found by a review of the Python module (2026-12-07): a finite scene spanning
+// ±3e38 aborted the process in Embree's SAH builder (an area overflowing to
+// inf fails an assertion) for every BVH8 accelerator. The build boxes are now
+// scaled by a power of two first; the traversal's boxes are the triangles' own.
+TEST_CASE("bvh8: a finite scene wider than the float range of its box areas builds and traces exactly",
+          "[regression]") {
+  for (const int count : {1, 2}) {  // the review's scene, one triangle; and with a small one behind it
+    CAPTURE(count);
+    TriangleSoup s;
+    add_tri(s, {-3e38f, -3e38f, 0}, {3e38f, -3e38f, 0}, {0, 3e38f, 0});
+    if (count == 2) add_tri(s, {-1, -1, 5}, {1, -1, 5}, {0, 1, 5});
+    // The float modes' watertight test overflows on corners this large (it
+    // misses the big triangle, as `brute` does): they must build and equal the
+    // float brute force; the exact modes equal the exact reference.
+    const ExactTracer exact(s);
+    const BruteForceTracer brute(s);
+    for (const std::string name : {"bvh8", "bvh8-float", "bsp-bvh8", "bsp-bvh8-float"}) {
+      CAPTURE(name);
+      std::unique_ptr<Accelerator> t;
+      REQUIRE_NOTHROW(t = make_tracer(name, s, AccelOptions{}));
+      const Accelerator& ref = accel_info(name).certified ? static_cast<const Accelerator&>(exact) : brute;
+      for (const Ray& r : {ray_of({0, 0, -10}, {0, 0, 1}), ray_of({0, 0, 10}, {0, 0, -1}),
+                           ray_of({1e38f, 0, 1}, {0, 0, -1}), ray_of({0.1f, 0.2f, 2}, {0, 0, 1}),
+                           ray_of({5e37f, 1e37f, -1}, {0, 0, 1})}) {
+        const Hit want = ref.trace(r), got = t->trace(r);
+        CHECK(got.prim == want.prim);
+        CHECK(got.t == want.t);
+      }
+    }
   }
 }

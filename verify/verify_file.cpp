@@ -27,6 +27,9 @@ VerifyInput read_verify_input(const TreeFileReader& r, const TriangleSoup& soup)
   in.has_flat = has_flat_bsp_sections(r);
   if (in.has_flat) {
     const FlatBspHeaderRecord fh = r.record<FlatBspHeaderRecord>(kFlatBspHeaderTag);
+    if (fh.version != kFlatBspVersion)  // read_flat_bsp_sections refuses it too: no traversal could load it
+      throw InputError(r.path(), "flat BSP layout version " + std::to_string(fh.version) + ", expected " +
+                                     std::to_string(kFlatBspVersion));
     for (int a = 0; a < 3; ++a) {
       in.flat_box.lo[a] = fh.root_lo[a];
       in.flat_box.hi[a] = fh.root_hi[a];

@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "builder/bsp/bsp_candidates.h"
+#include "bsprt/error.h"
 #include "geometry/core/check.h"
 
 namespace bsprt {
@@ -287,6 +288,7 @@ Box3f bsp_root_box(const TriangleSoup& soup, const std::vector<std::uint32_t>& t
 
 BspTree build_bsp(const TriangleSoup& soup, const BspConfig& config, BspBuildReport* report,
                   const BspProgressFn& progress) {
+  check_threads(config.threads, "BspConfig::threads");
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::uint32_t> ids;
   for (std::uint32_t t = 0; t < soup.size(); ++t)

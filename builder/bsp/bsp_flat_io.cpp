@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "builder/bsp/bsp_file.h"
+#include "builder/root_box.h"
 #include "bsprt/error.h"
 
 namespace bsprt {
@@ -41,6 +42,7 @@ FlatBspTree read_flat_bsp_sections(const TreeFileReader& r, const TriangleSoup& 
   flat.bounds.lo = {h.root_lo[0], h.root_lo[1], h.root_lo[2]};
   flat.bounds.hi = {h.root_hi[0], h.root_hi[1], h.root_hi[2]};
   flat.triangle_count = h.triangle_count;
+  check_root_box(r.path(), "flat BSP root box", flat.bounds, soup);
   flat.nodes = r.array<FlatBspNode>(kFlatBspNodesTag);
   flat.prims = r.array<std::uint32_t>(kFlatBspPrimsTag);
   try {

@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 
+#include "builder/root_box.h"
 #include "traverse/kd/kd_traverse.h"
 
 namespace bsprt {
@@ -57,7 +58,9 @@ KdTree read_kd_tree(const TreeFileReader& r, const TriangleSoup& soup, KdConfig*
   const std::string& path = r.path();
   if (r.kind() != TreeKind::Kd) throw InputError(path, "not a kd tree file (it holds another tree kind)");
   r.check_scene(soup);
-  return read_kd_sections(r, std::uint32_t(soup.size()), config);
+  KdTree tree = read_kd_sections(r, std::uint32_t(soup.size()), config);
+  check_root_box(path, "kd-tree root box", tree.bounds, soup);
+  return tree;
 }
 
 KdTree read_kd_sections(const TreeFileReader& r, std::uint32_t triangle_count, KdConfig* config) {
@@ -69,6 +72,7 @@ KdTree read_kd_sections(const TreeFileReader& r, std::uint32_t triangle_count, K
   const BoundsRecord b = r.record<BoundsRecord>(kKdBoundsTag);
   tree.bounds.lo = {b.lo[0], b.lo[1], b.lo[2]};
   tree.bounds.hi = {b.hi[0], b.hi[1], b.hi[2]};
+  check_box_finite(path, "kd-tree root box", tree.bounds);
   const ConfigRecord c = r.record<ConfigRecord>(kKdConfigTag);
   if (config) {
     *config = KdConfig{c.traversal_cost, c.intersection_cost, c.empty_bonus, c.max_depth,

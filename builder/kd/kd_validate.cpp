@@ -96,6 +96,16 @@ void validate_kd_coverage(const KdTree& tree, const TriangleSoup& soup) {
       poly.push_back({{Q(v.x), Q(v.y), Q(v.z)}});
     }
     if (poly.empty()) continue;
+    // The leaves cover the root box only: a triangle reaching out of it would
+    // be clipped below and its outside part never checked (nor ever hit).
+    bool inside = true;
+    for (const Vec3f& v : soup.corners(t))
+      for (int a = 0; a < 3; ++a) inside = inside && tree.bounds.lo[a] <= v[a] && v[a] <= tree.bounds.hi[a];
+    if (!inside) {
+      std::ostringstream s;
+      s << "kd-tree: triangle " << t << " sticks out of the root box (its points outside lie in no leaf)";
+      throw std::logic_error(s.str());
+    }
     Checker c{tree, t};
     if (!c.found(0, clip_box(poly, tree.bounds))) {
       std::ostringstream s;

@@ -6,10 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <iterator>
+#include <filesystem>
+#include <system_error>
 
 #include "bsprt/error.h"
+#include "geometry/core/read_file.h"
 
 namespace bsprt {
 namespace {
@@ -36,9 +37,7 @@ Vec3f vec_field(const std::string& path, const json& cam, const std::string& who
 }  // namespace
 
 std::vector<NamedCamera> read_camera_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open camera file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = read_file_bytes(path, "camera file");
   json doc;
   try {
     doc = json::parse(text);
@@ -64,14 +63,11 @@ std::vector<NamedCamera> read_camera_file(const std::string& path) {
     nc.camera.vp = vec_field(path, c, who, "vp");
     nc.camera.vi = vec_field(path, c, who, "vi");
     nc.camera.vu = vec_field(path, c, who, "vu");
-    if (!c.contains("fov") || !c["fov"].is_number()) throw InputError(path, who + ": \"fov\" (degrees) is missing");
+    if (!c.contains("fov")) throw InputError(path, who + ": field \"fov\" (degrees) is missing");
+    if (!c["fov"].is_number()) throw InputError(path, who + ": \"fov\" must be a number (degrees)");
     nc.camera.fov = c["fov"].get<float>();
-    if (!(nc.camera.fov > 0.0f && nc.camera.fov < 180.0f))
-      throw InputError(path, who + ": fov " + std::to_string(nc.camera.fov) + " is not in (0, 180) degrees");
-    const Vec3f view = nc.camera.vi - nc.camera.vp;
-    if (dot(view, view) == 0.0f) throw InputError(path, who + ": vp and vi are the same point");
-    const Vec3f side = cross(view, nc.camera.vu);
-    if (dot(side, side) == 0.0f) throw InputError(path, who + ": vu is parallel to the view direction (or zero)");
+    if (const std::string problem = camera_problem(nc.camera); !problem.empty())
+      throw InputError(path, who + ": " + problem);
     for (const NamedCamera& o : out)
       if (o.name == nc.name) throw InputError(path, who + ": the name is used twice");
     out.push_back(std::move(nc));
@@ -81,9 +77,18 @@ std::vector<NamedCamera> read_camera_file(const std::string& path) {
 }
 
 NamedCamera camera_from_spec(const std::string& spec) {
-  // FILE:NAME when the part after the last ':' is not itself a path to an existing file.
-  const std::size_t colon = spec.rfind(':');
-  const bool named = colon != std::string::npos && !std::ifstream(spec).good();
+  // FILE:NAME, split at the first ':' whose left part is an existing file, so
+  // that a name may hold ':' too; the whole spec is FILE when it is a file.
+  std::error_code ec;
+  std::size_t colon = std::string::npos;
+  if (!std::filesystem::is_regular_file(spec, ec))
+    for (std::size_t at = spec.find(':'); at != std::string::npos; at = spec.find(':', at + 1))
+      if (std::filesystem::is_regular_file(spec.substr(0, at), ec)) {
+        colon = at;
+        break;
+      }
+  if (colon == std::string::npos && !std::filesystem::is_regular_file(spec, ec)) colon = spec.rfind(':');
+  const bool named = colon != std::string::npos;
   const std::string path = named ? spec.substr(0, colon) : spec;
   const std::vector<NamedCamera> cams = read_camera_file(path);
   std::string names;

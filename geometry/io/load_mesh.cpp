@@ -44,6 +44,7 @@
 #include <cstring>
 
 #include "bsprt/error.h"
+#include "geometry/core/read_file.h"
 #include "geometry/io/mesh_scan.h"
 #include "geometry/io/openmesh_import.h"
 #include "robust/degenerate.h"
@@ -76,15 +77,7 @@ std::string lower_extension(const std::string& path) {
 }
 
 std::string read_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open file for reading");
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) throw InputError(path, "error while reading the file");
-  std::string bytes = std::move(s).str();
+  std::string bytes = read_file_bytes(path, "mesh file");
   if (bytes.empty()) throw InputError(path, "file is empty");
   return bytes;
 }

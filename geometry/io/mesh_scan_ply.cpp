@@ -171,6 +171,16 @@ void check_supported(const std::string& path, const PlyHeader& h, ElementScan& s
     if (e.name == "face") {
       if (std::none_of(e.props.begin(), e.props.end(), [](const PlyProperty& p) { return p.indices; }))
         throw InputError(path, e.line, "PLY face element has no vertex_indices list");
+      // Valid PLY, but OpenMesh misreads both layouts (0 vertices, or the
+      // scalar taken as part of the index list): say so, not that it disagrees.
+      if (!have_vertex)
+        throw InputError(path, e.line,
+                         "PLY face element before the vertex element is not supported (OpenMesh, which reads PLY "
+                         "here, needs the vertices first)");
+      if (!e.props.front().indices)
+        throw InputError(path, e.line,
+                         "PLY face property '" + e.props.front().name +
+                             "' before vertex_indices is not supported (OpenMesh reads the index list first)");
       scan.faces = e.count;
       have_face = true;
     }

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <string>
 
+#include "bsprt/compare.h"
 #include "bsprt/error.h"
 
 namespace bsprt {
@@ -114,7 +115,13 @@ void write_rays(const std::string& path, std::span<const Ray> rays) {
   write_records(path, kRays, rays.data(), rays.size());
 }
 
-std::vector<Hit> read_hits(const std::string& path) { return read_records<Hit>(path, kHits); }
+std::vector<Hit> read_hits(const std::string& path) {
+  std::vector<Hit> hits = read_records<Hit>(path, kHits);
+  for (std::size_t i = 0; i < hits.size(); ++i)
+    if (const char* why = hit_record_problem(hits[i]))
+      throw InputError(path, "hit record " + std::to_string(i) + " is " + why + " (formats.md)");
+  return hits;
+}
 
 void write_hits(const std::string& path, std::span<const Hit> hits) {
   write_records(path, kHits, hits.data(), hits.size());

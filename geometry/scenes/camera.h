@@ -3,6 +3,8 @@
 /// A pinhole camera with Embree-tutorial parameters (--vp, --vi, --vu, --fov),
 /// and primary-ray generation shared by the renderer and `bsprt gen-rays`.
 
+#include <string>
+
 #include "bsprt/ray.h"
 #include "bsprt/vec3.h"
 
@@ -15,6 +17,13 @@ struct Camera {
   Vec3f vu{0, 1, 0};   ///< up direction (--vu)
   float fov = 60.0f;   ///< vertical field of view in degrees (--fov)
 };
+
+/// What makes `cam` unusable, or "" when it is fine: a non-finite field, vp
+/// and vi the same point, vu zero or parallel to the view direction, fov not
+/// in (0, 180) degrees. Camera files and the --vp/--vi/--vu/--fov options are
+/// checked with it, so neither can render a black image from a camera that
+/// looks nowhere.
+std::string camera_problem(const Camera& cam);
 
 /// Precomputed image-plane basis for generating primary rays quickly.
 class CameraRays {

@@ -23,9 +23,13 @@ std::vector<std::uint32_t> live_triangles(const TriangleSoup& soup) {
 struct OriginSampler {
   explicit OriginSampler(const TriangleSoup& soup) {
     const Box3f b = soup.bounds();
+    if (!(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z))
+      throw UsageError("the scene has no non-degenerate triangle, so it has no box to draw ray origins from");
     const Vec3f pad = b.diagonal() * 0.1f;
     lo = b.lo - pad;
     size = b.diagonal() + pad * 2.0f;
+    if (!is_finite(lo) || !is_finite(size))
+      throw UsageError("the scene's bounds padded by 10 % overflow float: no box to draw ray origins from");
   }
   Vec3f operator()(std::mt19937_64& rng) const {
     std::uniform_real_distribution<float> u(0.0f, 1.0f);

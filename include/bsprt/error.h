@@ -37,4 +37,17 @@ class UsageError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// The largest worker-thread count any `threads` option or argument takes.
+/// oneTBB's arenas crash above 65535 (a segfault, not an error), and 4096 is
+/// more than any machine this runs on has cores.
+inline constexpr int kMaxThreads = 4096;
+
+/// Throws UsageError naming `what` unless 0 <= threads <= kMaxThreads
+/// (0 = all cores).
+inline void check_threads(int threads, const std::string& what) {
+  if (threads < 0 || threads > kMaxThreads)
+    throw UsageError(what + " must be between 0 (all cores) and " + std::to_string(kMaxThreads) + ", not " +
+                     std::to_string(threads));
+}
+
 }  // namespace bsprt

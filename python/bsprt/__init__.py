@@ -24,7 +24,7 @@ from ._bsprt import (HIT_DTYPE, Cancelled, InputError, Tree, __version__, compar
 from ._bsprt import Scene
 from ._bsprt import _Tracer
 
-__all__ = ["Scene", "Tree", "Tracer", "Hits", "HIT_DTYPE", "InputError", "Cancelled", "compare",
+__all__ = ["Scene", "Tree", "Tracer", "Hits", "HIT_DTYPE", "NO_HIT", "InputError", "Cancelled", "compare",
            "read_rays", "write_rays", "read_hits", "write_hits", "make_rays", "__version__"]
 
 NO_HIT = 0xFFFFFFFF
@@ -43,38 +43,73 @@ def _hits(records: np.ndarray) -> Hits:
     return Hits(records["t"], records["prim"], records["u"], records["v"], records)
 
 
-def _column(name: str, a, n: int, default: float) -> np.ndarray:
+def _numbers(name: str, a) -> np.ndarray:
+    """`a` as an array of floats or integers (bool and other kinds refused)."""
+    a = np.asarray(a)
+    if a.dtype.kind not in "fiu":
+        raise ValueError(f"{name}: expected float (or integer) numbers, got dtype {a.dtype}")
+    return a
+
+
+def _to_float32(name: str, a: np.ndarray) -> np.ndarray:
+    """Rounds to float32 (to nearest); ValueError where a finite value overflows."""
+    with np.errstate(over="ignore"):
+        f = a.astype(np.float32)
+    bad = np.isfinite(a) & ~np.isfinite(f)
+    if bad.any():
+        first = np.argwhere(bad)[0]
+        raise ValueError(f"{name}: value {a[tuple(first)]!r} at {tuple(int(i) for i in first)} overflows float32, "
+                         "the precision bsprt traces in")
+    return f
+
+
+def _bound(name: str, a, n: int, default: float, up: bool) -> np.ndarray:
+    """tnear (up=True) or tfar as float32, rounded outward-in: tnear up and tfar
+    down, so the float32 interval never holds a t outside the one asked for."""
     if a is None:
         return np.full(n, default, dtype=np.float32)
-    a = np.asarray(a)
+    a = _numbers(name, a)
     if a.ndim == 0:
         a = np.full(n, a, dtype=a.dtype)
-    if a.dtype.kind != "f":
-        raise ValueError(f"{name}: expected a float array, got dtype {a.dtype}")
     if a.shape != (n,):
         raise ValueError(f"{name}: expected shape ({n},), got {a.shape}")
-    return a
+    if a.dtype == np.float32:
+        return a
+    a = a.astype(np.float64)
+    with np.errstate(over="ignore"):
+        f = a.astype(np.float32)
+    off = f > a if up is False else f < a  # rounded past the bound asked for (NaN compares False)
+    f[off] = np.nextafter(f[off], np.float32(np.inf if up else -np.inf))
+    return f
 
 
 def make_rays(origins, directions, tnear=None, tfar=None) -> np.ndarray:
     """Packs origins (N, 3), directions (N, 3), tnear and tfar (N,) or scalars into
-    the (N, 8) float32 .rays layout. Float64 input is rounded to float32 (the
-    precision bsprt traces in); NaN or reversed intervals make rays that miss."""
-    o = np.asarray(origins)
-    d = np.asarray(directions)
+    the (N, 8) float32 .rays layout (docs/api.md, "Rays from float64"). Float64
+    (or integer) origins and directions are rounded to the nearest float32, the
+    precision bsprt traces in, and a finite value that overflows float32 is a
+    ValueError; tnear is rounded up and tfar down, so that no hit outside the
+    interval asked for is reported. NaN or reversed intervals make rays that miss."""
+    o = _numbers("origins", origins)
+    d = _numbers("directions", directions)
     for name, a in (("origins", o), ("directions", d)):
-        if a.dtype.kind != "f":
-            raise ValueError(f"{name}: expected a float array, got dtype {a.dtype}")
         if a.ndim != 2 or a.shape[1] != 3:
             raise ValueError(f"{name}: expected shape (N, 3), got {a.shape}")
     if o.shape != d.shape:
         raise ValueError(f"origins {o.shape} and directions {d.shape} differ in shape")
     n = o.shape[0]
     rays = np.empty((n, 8), dtype=np.float32)
-    rays[:, 0:3] = o
-    rays[:, 3] = _column("tnear", tnear, n, 0.0)
-    rays[:, 4:7] = d
-    rays[:, 7] = _column("tfar", tfar, n, np.inf)
+    rays[:, 0:3] = _to_float32("origins", o)
+    rays[:, 3] = _bound("tnear", tnear, n, 0.0, up=True)
+    rays[:, 4:7] = _to_float32("directions", d)
+    rays[:, 7] = _bound("tfar", tfar, n, np.inf, up=False)
+    return rays
+
+
+def _rays_array(rays) -> np.ndarray:
+    if not isinstance(rays, np.ndarray):
+        raise TypeError(f"rays: expected an (N, 8) float32 numpy array of .rays records, got {type(rays).__name__}; "
+                        "bsprt.make_rays(origins, directions, tnear, tfar) makes one")
     return rays
 
 
@@ -106,7 +141,7 @@ class Tracer:
 
     def intersect_rays(self, rays: np.ndarray, threads: int = 0, packet_width: int = 1) -> Hits:
         """Nearest hits of an (N, 8) float32 array of .rays records, traced in place."""
-        return _hits(self._t._intersect_rays(rays, threads, packet_width))
+        return _hits(self._t._intersect_rays(_rays_array(rays), threads, packet_width))
 
     def intersect(self, origins, directions, tnear=None, tfar=None, threads: int = 0,
                   packet_width: int = 1) -> Hits:
@@ -114,7 +149,8 @@ class Tracer:
         return self.intersect_rays(make_rays(origins, directions, tnear, tfar), threads, packet_width)
 
     def occluded_rays(self, rays: np.ndarray, threads: int = 0, packet_width: int = 1) -> np.ndarray:
-        return self._t._occluded_rays(rays, threads, packet_width).astype(bool)
+        """True where the ray of an (N, 8) float32 array of .rays records hits anything in [tnear, tfar]."""
+        return self._t._occluded_rays(_rays_array(rays), threads, packet_width).astype(bool)
 
     def occluded(self, origins, directions, tnear=None, tfar=None, threads: int = 0,
                  packet_width: int = 1) -> np.ndarray:

@@ -158,8 +158,13 @@ def test_bad_rays_raise_value_error(suzanne):
         t.intersect(o[:, :2], d)
     with pytest.raises(ValueError, match="differ"):
         t.intersect(o[:3], d)
+    # Integer coordinates are numbers too (traced as their float32 values);
+    # booleans and complex numbers are not.
+    assert np.array_equal(t.intersect(o.astype(np.int32), d).records, t.intersect(o, d).records)
     with pytest.raises(ValueError, match="float"):
-        t.intersect(o.astype(np.int32), d)
+        t.intersect(o.astype(bool), d)
+    with pytest.raises(ValueError, match="float"):
+        t.intersect(o.astype(np.complex64), d)
     with pytest.raises(ValueError, match="tnear"):
         t.intersect(o, d, tnear=np.zeros(3))
     with pytest.raises(ValueError, match="dtype"):
@@ -214,3 +219,104 @@ def test_progress_exception_cancels_build(suzanne):
 
     with pytest.raises(KeyboardInterrupt):
         scene.build(accel="bsp", progress=stop)
+
+
+# Found by a review of the module (2026-12-07); each was a crash, a silent
+# loss or a misleading error before.
+
+
+def test_progress_exception_on_the_last_report_is_raised(suzanne):
+    """An exception from the final (total, total) report was dropped: nothing
+    polled cancel after it, and build() returned a tree."""
+    scene = bsprt.Scene.load(suzanne)
+
+    def at_end(done, total):
+        if total > 0 and done == total:
+            raise RuntimeError("raised at the end")
+
+    for accel in ("kd", "bsp"):
+        with pytest.raises(RuntimeError, match="raised at the end"):
+            scene.build(accel=accel, threads=1, progress=at_end)
+
+
+def test_float64_rays_never_reach_outside_the_interval_asked_for(scenes):
+    """tnear and tfar were rounded to nearest: a hit at 4.5 came back for
+    tfar = 4.49999999 and for tnear = 4.50000001."""
+    t = bsprt.Tracer(bsprt.Scene.load(os.path.join(scenes, "cube.obj")), accel="bsp")
+    o = np.array([[0.1, 0.2, -5.0]])
+    d = np.array([[0.0, 0.0, 1.0]])
+    front = float(t.intersect(o, d).t[0])
+    assert front == 4.5  # the cube spans [-0.5, 0.5]
+    assert not np.isfinite(t.intersect(o, d, tfar=4.49999999).t[0])
+    assert t.intersect(o, d, tnear=4.50000001).t[0] > 4.5
+    assert t.intersect(o, d, tfar=4.5).t[0] == 4.5  # a float64 bound that is a float32 stays put
+    assert t.intersect(o, d, tfar=10).t[0] == 4.5  # an int scalar, like 10.0
+    rays = bsprt.make_rays(o, d, tnear=np.array([0.1]), tfar=np.array([1e39]))
+    assert rays[0, 3] >= 0.1 and rays[0, 7] == np.finfo(np.float32).max
+    with pytest.raises(ValueError, match="overflows float32"):
+        t.intersect(np.array([[0.0, 0.0, -1e39]]), d)
+
+
+def test_paths_are_str_or_pathlike_and_never_hold_nul(tmp_path, suzanne):
+    import pathlib
+    scene = bsprt.Scene.load(pathlib.Path(suzanne))
+    tree = scene.build(accel="kd")
+    tree.save(tmp_path / "s.kd")
+    assert bsprt.Tree.load(tmp_path / "s.kd", scene).kind == "kd"
+    rays = bsprt.make_rays(np.zeros((3, 3)), np.ones((3, 3)))
+    bsprt.write_rays(tmp_path / "r.rays", rays)
+    assert np.array_equal(bsprt.read_rays(tmp_path / "r.rays"), rays)
+    with pytest.raises(ValueError, match="NUL"):
+        bsprt.Scene.load(suzanne + "\0junk")
+    with pytest.raises(TypeError):
+        bsprt.Scene.load(5)
+
+
+def test_errors_name_what_the_caller_passed(scenes):
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    with pytest.raises(ValueError, match="is vertex 18446744073709551615"):  # not "vertex -1"
+        bsprt.Scene(v, np.array([[0, 1, 2**64 - 1]], np.uint64))
+    scene = bsprt.Scene.load(os.path.join(scenes, "cube.obj"))
+    for threads in (-1, 70000):
+        with pytest.raises(ValueError, match="threads"):
+            scene.build(accel="kd", threads=threads)
+        with pytest.raises(ValueError, match="threads"):
+            scene.verify(scene.build(accel="kd"), threads=threads)
+    # Embree named the ray by its index within a block of 4096 (or 0).
+    e = bsprt.Tracer(scene, accel="embree")
+    rays = np.tile(np.array([[0, 0, -5, 0, 0, 0, 1, np.inf]], np.float32), (5000, 1))
+    rays[4100, 3] = -1.0
+    for call in (lambda: e.intersect_rays(rays, threads=2), lambda: e.occluded_rays(rays, threads=1)):
+        with pytest.raises(ValueError, match="ray 4100 has tnear < 0"):
+            call()
+    with pytest.raises(TypeError, match="make_rays"):
+        e.intersect_rays([[0, 0, -5, 0, 0, 0, 1, np.inf]])
+    with pytest.raises(ValueError, match="tolerance"):
+        h = e.intersect_rays(rays[:2]).records
+        bsprt.compare(h, h, rel_tol=-1)
+    assert "NO_HIT" in bsprt.__all__
+
+
+def test_exact_reference_misses_in_a_segment_at_infinity(scenes):
+    """tnear = tfar = +inf (or -inf): no finite t lies there. The exact
+    reference dropped an infinite bound whatever its side and hit the cube."""
+    scene = bsprt.Scene.load(os.path.join(scenes, "cube.obj"))
+    inf = np.inf
+    rays = np.array([[0, 0, -5, inf, 0, 0, 1, inf], [0, 0, -5, -inf, 0, 0, 1, -inf]], np.float32)
+    for accel in ("exact", "brute-certified", "bsp", "kd"):
+        hits = bsprt.Tracer(scene, accel=accel).intersect_rays(rays)
+        assert np.all(hits.prim == bsprt.NO_HIT), accel
+
+
+def test_compare_counts_a_wrong_t_on_the_right_triangle(scenes):
+    scene = bsprt.Scene.load(os.path.join(scenes, "cube.obj"))
+    t = bsprt.Tracer(scene, accel="bsp")
+    hits = t.intersect(np.array([[0.1, 0.2, -5.0]], np.float32), np.array([[0, 0, 1]], np.float32)).records
+    wrong = hits.copy()
+    wrong["t"] *= 3
+    c = bsprt.compare(hits, wrong)
+    assert c["t_off"] == 1 and not c["agrees"] and c["first_bad_ray"] == 0
+    broken = hits.copy()
+    broken["t"] = np.nan
+    with pytest.raises(ValueError, match="not finite"):
+        bsprt.compare(hits, broken)

@@ -2,6 +2,8 @@
 /// EmbreeBuild (build_device.h): the shared device, the lock, one rtcBuildBVH run.
 #include "traverse/embree/build_device.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -29,6 +31,20 @@ std::mutex& build_lock() {
 
 EmbreeBuild::EmbreeBuild(std::vector<RTCBuildPrimitive>& prims, std::size_t count, const EmbreeBuildSettings& s)
     : lock_(build_lock()) {
+  float big = 0.0f;
+  for (std::size_t i = 0; i < count; ++i) {
+    const RTCBuildPrimitive& p = prims[i];
+    for (const float v : {p.lower_x, p.lower_y, p.lower_z, p.upper_x, p.upper_y, p.upper_z})
+      big = std::max(big, std::fabs(v));
+  }
+  if (big > 0x1p60f) {
+    const int shift = std::ilogb(big) - 60;  // exact scaling by 2^-shift (tiny values may round: topology only)
+    for (std::size_t i = 0; i < count; ++i) {
+      RTCBuildPrimitive& p = prims[i];
+      for (float* v : {&p.lower_x, &p.lower_y, &p.lower_z, &p.upper_x, &p.upper_y, &p.upper_z})
+        *v = std::ldexp(*v, -shift);
+    }
+  }
   const RTCDevice device = shared_build_device();
   bvh_ = rtcNewBVH(device);
   RTCBuildArguments args = rtcDefaultBuildArguments();

@@ -31,7 +31,13 @@ struct EmbreeBuildSettings {
 /// One rtcBuildBVH run over prims[0..count) (prims may be larger: spare
 /// capacity for the builder). Holds the build lock and the BVH object (whose
 /// memory holds what the callbacks allocated) until destroyed. Throws
-/// std::runtime_error when Embree fails.
+/// std::runtime_error when Embree fails. Our callbacks take no bounds from
+/// Embree (set_bounds ignores them; boxes are recomputed from the primitives),
+/// so when the boxes reach beyond 2^60 they are first scaled by a power of two
+/// to at most that: Embree's SAH computes box areas in float, and an area
+/// that overflows to inf fails an assertion inside Embree (an abort, found on
+/// a finite scene spanning ±3e38). The SAH is scale-invariant, so the tree
+/// is the one the unscaled boxes would give, up to rounding.
 class EmbreeBuild {
  public:
   EmbreeBuild(std::vector<RTCBuildPrimitive>& prims, std::size_t count, const EmbreeBuildSettings& settings);
