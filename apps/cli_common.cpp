@@ -64,6 +64,11 @@ CLI::Validator integer_in(long long lo, long long hi) {
       fmt::format("INT in [{}, {}]", lo, hi));
 }
 
+CLI::Validator non_empty_path() {
+  return CLI::Validator([](std::string& s) -> std::string { return s.empty() ? "must not be an empty path" : ""; },
+                        "PATH");
+}
+
 void reject_given(const CLI::App& cmd, const std::vector<std::string>& names, const std::string& why) {
   std::string given;
   for (const std::string& n : names)
@@ -76,7 +81,8 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
   std::string names;
   for (const std::string& n : accel_names()) names += (names.empty() ? "" : "|") + n;
   cmd.add_option("--accel", o.accel, "accelerator: " + names)->capture_default_str();
-  cmd.add_option("--tree", o.tree, "tree file written by `bsprt build` (kd, bsp); built in memory if absent");
+  cmd.add_option("--tree", o.tree, "tree file written by `bsprt build` (kd, bsp); built in memory if absent")
+      ->check(non_empty_path());
   cmd.add_option("--threads", o.threads, "worker threads (0 = all cores)")
       ->check(integer_in(0, kMaxThreads))->capture_default_str();
   cmd.add_option("--packets", o.packets, "rays per packet: 1 (single rays), 4, 8 or 16")

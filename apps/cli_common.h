@@ -38,6 +38,8 @@ CLI::Validator number_above(double lo);
 CLI::Validator number_at_least(double lo);
 CLI::Validator number_in_open(double lo, double hi);
 CLI::Validator integer_in(long long lo, long long hi);
+/// A path option given as an empty string (it would mean "not given").
+CLI::Validator non_empty_path();
 
 /// Largest ray count `gen-rays -n` writes (32 GB of rays), and largest image
 /// side of --size: past these a run fails for memory, not for a reason a

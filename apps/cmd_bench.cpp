@@ -136,7 +136,8 @@ void register_bench(CLI::App& app) {
       ->capture_default_str()->check(integer_in(1, 1000));
   cmd->add_option("--seed", args->seed, "ray-set seed")->capture_default_str();
   cmd->add_option("--cameras", args->cameras,
-                  "camera file (e.g. bench/cameras.json): a scene it names traces its primary rays from that camera");
+                  "camera file (e.g. bench/cameras.json): a scene it names traces its primary rays from that camera")
+      ->check(non_empty_path());
   cmd->add_option("-o,--output", args->output, "directory for PREFIX.md, .csv, .json")->capture_default_str();
   cmd->add_option("--prefix", args->prefix, "base name of the output files")->capture_default_str();
   cmd->callback([args] { run(*args); });

@@ -57,7 +57,8 @@ void register_gen_rays(CLI::App& app) {
   cmd->add_option("--kind", args->kind, "primary | random | vertex | edge")->capture_default_str();
   cmd->add_option("-n,--count", args->count, "number of rays (primary: about n pixels, square)")
       ->capture_default_str()->check(integer_in(1, kMaxRays));
-  cmd->add_option("--camera", args->camera, "primary rays: camera file FILE or FILE:NAME (docs/rendering.md)");
+  cmd->add_option("--camera", args->camera, "primary rays: camera file FILE or FILE:NAME (docs/rendering.md)")
+      ->check(non_empty_path());
   cmd->add_option("--size", args->size, "primary rays: image width and height (camera frames the scene)")
       ->expected(2)->check(integer_in(1, kMaxImageSide));
   cmd->add_option("--seed", args->seed, "random seed")->capture_default_str();

@@ -199,7 +199,8 @@ void register_render(CLI::App& app) {
   cmd->add_option("--fov", args->fov, "vertical field of view in degrees, in (0, 180)")->check(number_in_open(0, 180));
   cmd->add_option("--camera", args->camera,
                   "camera file (docs/rendering.md), FILE or FILE:NAME, e.g. bench/cameras.json:sponza-atrium; "
-                  "--vp/--vi/--vu/--fov override its fields");
+                  "--vp/--vi/--vu/--fov override its fields")
+      ->check(non_empty_path());
   cmd->add_flag("--stats", args->stats, "cast: count and print node visits and triangle tests per ray; path: the same per bounce, also "
                 "in --json (the timings then include the counting)");
   cmd->add_option("--spp", args->spp, "path: samples per pixel")->capture_default_str()->check(integer_in(1, 1 << 20));

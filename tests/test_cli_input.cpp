@@ -62,6 +62,8 @@ TEST_CASE("cli: counts, sizes, thread numbers and modes out of range are usage e
            Case{"bench " + cube + " --prefix ../x --count 10 -o " + temp_path("cli_in_bench"),
                 "--prefix must be a plain file name"},
            Case{"info ''", "SCENE is an empty string"},  // loaded the embedded default scene
+           Case{"render --camera ''" + png, "--camera: must not be an empty path"},  // were ignored
+           Case{"trace " + cube + " " + rays + hits + " --tree ''", "--tree: must not be an empty path"},
        }) {
     const Run r = bsprt_cli(c.args);
     INFO(c.args << "\n" << r.output);
