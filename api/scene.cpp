@@ -21,6 +21,13 @@ struct Scene::Impl {
 
 Scene::Scene(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 
+const Scene::Impl& Scene::impl() const {
+  if (!impl_)
+    throw UsageError("bsprt::Scene used after it was moved from (only assigning to it or destroying it is "
+                     "allowed)");
+  return *impl_;
+}
+
 Scene Scene::from_arrays(std::span<const float> vertices, std::span<const std::uint32_t> indices,
                          const SceneOptions& options) {
   if (vertices.size() % 3 != 0)
@@ -81,18 +88,18 @@ Scene Scene::default_scene() {
   return Scene(std::move(impl));
 }
 
-std::size_t Scene::triangle_count() const { return impl_->soup.size(); }
-std::size_t Scene::vertex_count() const { return impl_->soup.vertices.size(); }
-const SceneSummary& Scene::summary() const { return impl_->summary; }
-Box3f Scene::bounds() const { return impl_->soup.bounds(); }
-std::uint64_t Scene::fingerprint() const { return impl_->fingerprint; }
-const TriangleSoup& Scene::soup() const { return impl_->soup; }
+std::size_t Scene::triangle_count() const { return impl().soup.size(); }
+std::size_t Scene::vertex_count() const { return impl().soup.vertices.size(); }
+const SceneSummary& Scene::summary() const { return impl().summary; }
+Box3f Scene::bounds() const { return impl().soup.bounds(); }
+std::uint64_t Scene::fingerprint() const { return impl().fingerprint; }
+const TriangleSoup& Scene::soup() const { return impl().soup; }
 
 Vec3f Scene::corner(std::size_t t, int k) const {
-  if (t >= impl_->soup.size() || k < 0 || k > 2)
+  if (t >= impl().soup.size() || k < 0 || k > 2)
     throw UsageError("corner(" + std::to_string(t) + ", " + std::to_string(k) + "): the scene has " +
-                     std::to_string(impl_->soup.size()) + " triangles of 3 corners");
-  return impl_->soup.corner(std::uint32_t(t), k);
+                     std::to_string(impl().soup.size()) + " triangles of 3 corners");
+  return impl().soup.corner(std::uint32_t(t), k);
 }
 
 }  // namespace bsprt

@@ -20,6 +20,13 @@ struct Tracer::Impl {
 
 Tracer::Tracer(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 
+const Tracer::Impl& Tracer::impl() const {
+  if (!impl_)
+    throw UsageError("bsprt::Tracer used after it was moved from (only assigning to it or destroying it is "
+                     "allowed)");
+  return *impl_;
+}
+
 namespace {
 
 /// The `--accel` name of `mode` on a tree of `kind`.
@@ -87,38 +94,38 @@ Tracer Tracer::by_name(const Scene& scene, std::string_view accel) { return Trac
 Tracer Tracer::exact(const Scene& scene) { return by_name(scene, "exact"); }
 std::vector<std::string> Tracer::accelerators() { return accel_names(); }
 
-std::string Tracer::name() const { return impl_->name; }
-bool Tracer::certified() const { return impl_->certified; }
-std::size_t Tracer::memory_bytes() const { return impl_->accel->memory_bytes(); }
+std::string Tracer::name() const { return impl().name; }
+bool Tracer::certified() const { return impl().certified; }
+std::size_t Tracer::memory_bytes() const { return impl().accel->memory_bytes(); }
 
-Hit Tracer::intersect(const Ray& ray) const { return impl_->accel->trace(ray); }
+Hit Tracer::intersect(const Ray& ray) const { return impl().accel->trace(ray); }
 
 void Tracer::intersect(std::span<const Ray> rays, std::span<Hit> hits, const TraceOptions& options) const {
   check_options(options);
   if (rays.size() != hits.size())
     throw UsageError("intersect: " + std::to_string(rays.size()) + " rays but room for " + std::to_string(hits.size()) +
                      " hits");
-  check_domain(*impl_, rays);
+  check_domain(impl(), rays);
   for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
-    impl_->accel->trace_batch(rays.subspan(b, e - b), hits.subspan(b, e - b), options.packet_width);
+    impl().accel->trace_batch(rays.subspan(b, e - b), hits.subspan(b, e - b), options.packet_width);
   });
 }
 
-bool Tracer::occluded(const Ray& ray) const { return impl_->accel->occluded(ray); }
+bool Tracer::occluded(const Ray& ray) const { return impl().accel->occluded(ray); }
 
 void Tracer::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded, const TraceOptions& options) const {
   check_options(options);
   if (rays.size() != occluded.size())
     throw UsageError("occluded: " + std::to_string(rays.size()) + " rays but room for " +
                      std::to_string(occluded.size()) + " answers");
-  check_domain(*impl_, rays);
+  check_domain(impl(), rays);
   for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
     if (options.packet_width <= 1) {  // single rays: the tracer's own any-hit query (the BVH8 stops at a first hit)
-      for (std::size_t i = b; i < e; ++i) occluded[i] = impl_->accel->occluded(rays[i]) ? 1 : 0;
+      for (std::size_t i = b; i < e; ++i) occluded[i] = impl().accel->occluded(rays[i]) ? 1 : 0;
       return;
     }
     std::vector<Hit> hits(e - b);
-    impl_->accel->trace_batch(rays.subspan(b, e - b), hits, options.packet_width);
+    impl().accel->trace_batch(rays.subspan(b, e - b), hits, options.packet_width);
     for (std::size_t i = b; i < e; ++i) occluded[i] = hits[i - b].hit() ? 1 : 0;
   });
 }

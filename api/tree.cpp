@@ -28,6 +28,13 @@ struct Tree::Impl {
 
 Tree::Tree(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 
+const Tree::Impl& Tree::impl() const {
+  if (!impl_)
+    throw UsageError("bsprt::Tree used after it was moved from (only assigning to it or destroying it is "
+                     "allowed)");
+  return *impl_;
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -68,6 +75,12 @@ std::vector<std::byte> build_bsp_bytes(const TriangleSoup& soup, const BuildOpti
 
 Tree build(const Scene& scene, const BuildOptions& options) {
   check_threads(options.threads, "BuildOptions::threads");
+  if (options.kind != TreeKind::Kd && options.kind != TreeKind::Bsp)
+    throw UsageError("BuildOptions::kind must be TreeKind::Kd or TreeKind::Bsp, not " +
+                     std::to_string(std::uint32_t(options.kind)));
+  if (options.membership != Membership::Area && options.membership != Membership::Closed)
+    throw UsageError("BuildOptions::membership must be Membership::Area or Membership::Closed, not " +
+                     std::to_string(int(options.membership)));
   const auto t0 = Clock::now();
   const BuildMonitor monitor{options};
   auto impl = std::make_shared<Tree::Impl>(Tree::Impl{scene, {}, nullptr, 0.0});
@@ -85,13 +98,13 @@ Tree Tree::load(const std::string& path, const Scene& scene) {
   return Tree(std::move(impl));
 }
 
-void Tree::save(const std::string& path) const { write_tree_file_image(path, impl_->bytes); }
+void Tree::save(const std::string& path) const { write_tree_file_image(path, impl().bytes); }
 
-TreeKind Tree::kind() const { return impl_->reader->kind(); }
-std::span<const std::byte> Tree::bytes() const { return impl_->bytes; }
-double Tree::build_seconds() const { return impl_->build_seconds; }
-const Scene& Tree::scene() const { return impl_->scene; }
-std::shared_ptr<const TreeFileReader> Tree::file() const { return impl_->reader; }
+TreeKind Tree::kind() const { return impl().reader->kind(); }
+std::span<const std::byte> Tree::bytes() const { return impl().bytes; }
+double Tree::build_seconds() const { return impl().build_seconds; }
+const Scene& Tree::scene() const { return impl().scene; }
+std::shared_ptr<const TreeFileReader> Tree::file() const { return impl().reader; }
 
 namespace {
 

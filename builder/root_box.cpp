@@ -9,6 +9,10 @@
 namespace bsprt {
 
 void check_box_finite(const std::string& path, const std::string& what, const Box3f& box) {
+  // The empty box (+inf, -inf) of a tree over no hittable triangle, as the
+  // kd build gives a scene of degenerate triangles only: no ray enters it.
+  const Box3f empty;
+  if (box.lo == empty.lo && box.hi == empty.hi) return;
   for (int a = 0; a < 3; ++a)
     if (!(std::isfinite(box.lo[a]) && std::isfinite(box.hi[a]) && box.lo[a] <= box.hi[a]))
       throw InputError(path, what + " is not finite, or inverted, on axis " + std::to_string(a));

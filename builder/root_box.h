@@ -12,9 +12,10 @@
 
 namespace bsprt {
 
-/// Throws InputError naming `path` unless `box` is finite and not inverted
-/// (the part of check_root_box that needs no scene: a loader runs it before
-/// the structural checks, which compare splits against the box).
+/// Throws InputError naming `path` unless `box` is finite and not inverted,
+/// or is the empty Box3f{} of a tree over no hittable triangle (the part of
+/// check_root_box that needs no scene: a loader runs it before the
+/// structural checks, which compare splits against the box).
 void check_box_finite(const std::string& path, const std::string& what, const Box3f& box);
 
 /// Throws InputError naming `path` unless `box` is finite, not inverted, and

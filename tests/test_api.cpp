@@ -304,3 +304,45 @@ TEST_CASE("api: compare and the ray/hit files agree with bsprt compare", "[api]"
   CHECK_THROWS_AS(compare_hits(ref, std::span(tested).first(10)), UsageError);
   CHECK(std::string(version()) == BSPRT_VERSION_STRING);
 }
+
+// Found by a review of the C++ API (2026-12-07): a moved-from Scene, Tree or
+// Tracer crashed (a null impl) on any call; a kd-tree of a scene of
+// degenerate triangles only could be built but not traced or verified (its
+// empty root box); out-of-range enum values were taken silently; Embree's
+// single-ray error named "ray 0".
+TEST_CASE("api: moved-from objects, empty kd trees, bad enums and single-ray errors", "[api][regression]") {
+  Scene a = Scene::default_scene();
+  const Scene b = std::move(a);
+  CHECK_THROWS_WITH(a.triangle_count(), Catch::Contains("bsprt::Scene used after it was moved from"));
+  CHECK(b.triangle_count() == 6400);
+  Tracer t = Tracer::by_name(b, "brute");
+  const Tracer u = std::move(t);
+  CHECK_THROWS_AS(t.name(), UsageError);
+  CHECK_THROWS_AS(t.intersect(Ray{}), UsageError);
+  CHECK(u.name() == "brute");
+  BuildOptions kd;
+  kd.kind = TreeKind::Kd;
+  Tree tree = build(b, kd);
+  const Tree moved = std::move(tree);
+  CHECK_THROWS_AS(tree.kind(), UsageError);
+  CHECK(moved.kind() == TreeKind::Kd);
+
+  const Scene degenerate =
+      Scene::from_arrays(std::vector<float>{0, 0, 0, 1, 1, 1, 2, 2, 2}, std::vector<std::uint32_t>{0, 1, 2});
+  const Tree empty = build(degenerate, kd);
+  Ray r;
+  r.org = {-1, 0, 0}, r.dir = {1, 1, 1};
+  CHECK_FALSE(Tracer(degenerate, empty).intersect(r).hit());
+  CHECK(verify(degenerate, empty).certified);
+
+  BuildOptions bad;
+  bad.kind = TreeKind(7);
+  CHECK_THROWS_AS(build(b, bad), UsageError);
+  bad = BuildOptions{};
+  bad.membership = Membership(9);
+  CHECK_THROWS_AS(build(b, bad), UsageError);
+
+  Ray below;  // a valid ray Embree cannot trace
+  below.org = {0, 0, -5}, below.dir = {0, 0, 1}, below.tnear = -1.0f;
+  CHECK_THROWS_WITH(Tracer::by_name(b, "embree").intersect(below), Catch::Contains("embree: the ray has tnear < 0"));
+}

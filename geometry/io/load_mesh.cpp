@@ -38,6 +38,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <system_error>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -314,6 +315,8 @@ std::size_t apply_nonfinite_policy(const std::string& path, const Polygons& p, c
 TriangleSoup load_mesh(const std::string& path, const LoadOptions& options, LoadReport* report) {
   const auto start = std::chrono::steady_clock::now();
   const std::string ext = lower_extension(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not a mesh file");
   if (ext != "obj" && ext != "ply" && ext != "off" && ext != "stl")
     throw InputError(path, "unknown mesh file extension '" + ext + "' (expected .obj, .ply, .off or .stl)");
   std::string bytes = read_file(path);

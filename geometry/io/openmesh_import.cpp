@@ -135,11 +135,39 @@ class CappedBuffer final : public std::streambuf {
 
 /// Library code must not print. OpenMesh writes warnings to its global
 /// streams omerr (forwarded to std::cerr), omlog and omout, and in a few
-/// places straight to std::cerr. For the duration of a read, std::cerr writes
-/// into a capped string and omlog/omout are disabled. (Reconnecting the
-/// OpenMesh streams instead would leak: mostream::disconnect never frees the
-/// target that connect allocated.) Only valid under the global read mutex;
-/// another thread's std::cerr output during a read is captured (dropped) too.
+/// places straight to std::cerr. A read first runs with the three OpenMesh
+/// streams disabled (QuietOpenMesh), which touches nothing of the process's
+/// own: std::cerr keeps its buffer, and other threads' output is theirs. Only
+/// when OpenMesh fails, which the pre-pass makes rare, is the read repeated
+/// with CaptureOpenMeshOutput, so that the error can quote what OpenMesh
+/// said: for that read std::cerr writes into a capped string (another
+/// thread's std::cerr output during it is captured too, and swapping the
+/// buffer races with a concurrent writer; an API review of 2026-12-07 found
+/// that every load did this). Reconnecting the OpenMesh streams instead would
+/// leak: mostream::disconnect never frees the target that connect allocated.
+/// Both only under the global read mutex.
+class QuietOpenMesh {
+ public:
+  QuietOpenMesh()
+      : err_(::omerr().is_enabled()), log_(::omlog().is_enabled()), out_(::omout().is_enabled()) {
+    ::omerr().flush();
+    ::omerr().disable();
+    ::omlog().disable();
+    ::omout().disable();
+  }
+  ~QuietOpenMesh() {
+    ::omerr().flush();  // dropped while disabled
+    if (err_) ::omerr().enable();
+    if (log_) ::omlog().enable();
+    if (out_) ::omout().enable();
+  }
+  QuietOpenMesh(const QuietOpenMesh&) = delete;
+  QuietOpenMesh& operator=(const QuietOpenMesh&) = delete;
+
+ private:
+  bool err_, log_, out_;
+};
+
 class CaptureOpenMeshOutput {
  public:
   CaptureOpenMeshOutput()
@@ -183,16 +211,27 @@ OpenMeshResult openmesh_read(const std::string& path, const std::string& bytes,
   bool ok = false;
   {
     std::lock_guard<std::mutex> lock(openmesh_mutex());
-    CaptureOpenMeshOutput capture;
-    SoupImporter importer(result);
-    std::istringstream in(bytes, std::ios::in | std::ios::binary);
-    omio::Options opt = stl_binary ? omio::Options(omio::Options::Binary) : omio::Options();
-    try {
-      ok = omio::IOManager().read(in, ext, importer, opt);
-    } catch (const std::exception& e) {
-      result.log += std::string("exception: ") + e.what() + "\n";
+    const auto read = [&] {
+      result = OpenMeshResult{};
+      SoupImporter importer(result);
+      std::istringstream in(bytes, std::ios::in | std::ios::binary);
+      omio::Options opt = stl_binary ? omio::Options(omio::Options::Binary) : omio::Options();
+      try {
+        ok = omio::IOManager().read(in, ext, importer, opt);
+      } catch (const std::exception& e) {
+        ok = false;
+        result.log += std::string("exception: ") + e.what() + "\n";
+      }
+    };
+    {
+      QuietOpenMesh quiet;
+      read();
     }
-    result.log = capture.text() + result.log;
+    if (!ok) {  // again, to quote OpenMesh in the error
+      CaptureOpenMeshOutput capture;
+      read();
+      result.log = capture.text() + result.log;
+    }
   }
   if (!ok) {
     std::string msg = "OpenMesh could not read this " + ext + " file";

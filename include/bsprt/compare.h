@@ -10,7 +10,8 @@
 
 namespace bsprt {
 
-/// Counts of each outcome; every ray lands in exactly one of the seven after `rays`.
+/// Counts of each outcome; every ray lands in exactly one of the eight counts
+/// from both_miss to nearer.
 struct HitComparison {
   std::uint64_t rays = 0;
   std::uint64_t both_miss = 0;

@@ -74,6 +74,8 @@ class Scene {
 
  private:
   explicit Scene(std::shared_ptr<const Impl> impl);
+  /// *impl_; a UsageError for an object moved from (whose impl_ is null), not a crash.
+  const Impl& impl() const;
   std::shared_ptr<const Impl> impl_;
 };
 

@@ -44,7 +44,10 @@ class Cancelled : public std::runtime_error {
 };
 
 /// A built tree, held as the bytes of its tree file (formats.md): saving writes
-/// exactly what `bsprt build` writes, loading checks what `bsprt trace` checks.
+/// exactly what `bsprt build` writes. Loading checks the container (magic,
+/// version, CRC, sizes) and that the file was built for the scene; the tree's
+/// own sections are checked when a Tracer is made from it (as `bsprt trace`
+/// does) and proven by verify().
 class Tree {
  public:
   /// Reads a tree file built for `scene`. Throws InputError naming the file when
@@ -70,6 +73,8 @@ class Tree {
 
  private:
   explicit Tree(std::shared_ptr<const Impl> impl);
+  /// *impl_; a UsageError for an object moved from (whose impl_ is null), not a crash.
+  const Impl& impl() const;
   std::shared_ptr<const Impl> impl_;
   friend Tree build(const Scene&, const BuildOptions&);
 };
@@ -94,7 +99,7 @@ struct Certificate {
 /// Settings of `verify`.
 struct VerifyOptions {
   int threads = 0;      ///< worker threads; 0 = all cores
-  bool strict = false;  ///< listings that do not touch the leaf's cell fail (default: warnings)
+  bool strict = false;  ///< BSP trees: listings that do not touch the leaf's cell fail (default: warnings); kd: unused
 };
 
 /// Proves `tree` correct for `scene` with exact arithmetic, independently of

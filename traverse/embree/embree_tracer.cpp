@@ -152,11 +152,12 @@ inline bool surely_in_domain(const Ray& r) {
   return m <= large && r.tnear >= 0.0f;
 }
 
-/// Throws UsageError naming ray `index` (of the batch) when Embree cannot trace it.
-void check_embree_domain(const Ray& r, std::size_t index) {
+/// Throws UsageError naming ray `index` of a batch (or "the ray" for a
+/// single one, index < 0) when Embree cannot trace it.
+void check_embree_domain(const Ray& r, std::ptrdiff_t index) {
   if (const char* why = embree_cannot_trace(r))
-    throw UsageError("embree: ray " + std::to_string(index) + " has " + why +
-                     "; such a ray is valid (formats.md): kd, bsp, brute and exact trace it");
+    throw UsageError("embree: " + (index < 0 ? std::string("the ray") : "ray " + std::to_string(index)) + " has " +
+                     why + "; such a ray is valid (formats.md): kd, bsp, brute and exact trace it");
 }
 
 }  // namespace
@@ -209,7 +210,7 @@ inline Hit trace_checked(const EmbreeState& impl, const Ray& ray, RTCIntersectCo
 
 Hit EmbreeTracer::trace(const Ray& ray, RayCounters* counters) const {
   if (counters) ++counters->rays;
-  check_embree_domain(ray, 0);  // nullptr for invalid rays: they miss below
+  check_embree_domain(ray, -1);  // nullptr for invalid rays: they miss below
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   return trace_checked(*impl_, ray, &ctx);
@@ -217,7 +218,7 @@ Hit EmbreeTracer::trace(const Ray& ray, RayCounters* counters) const {
 
 bool EmbreeTracer::occluded(const Ray& ray, RayCounters* counters) const {
   if (counters) ++counters->rays;
-  check_embree_domain(ray, 0);
+  check_embree_domain(ray, -1);
   if (!is_valid(ray)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
@@ -234,7 +235,7 @@ void EmbreeTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, i
   if (packet_width != 1 && packet_width != 4 && packet_width != 8 && packet_width != 16)
     throw UsageError("packet width must be 1, 4, 8 or 16, not " + std::to_string(packet_width));
   for (std::size_t i = 0; i < rays.size(); ++i)  // before any ray is traced
-    if (!surely_in_domain(rays[i])) check_embree_domain(rays[i], i);
+    if (!surely_in_domain(rays[i])) check_embree_domain(rays[i], std::ptrdiff_t(i));
   if (packet_width == 1) {  // each ray checked once (above), one context for the batch
     if (counters) counters->rays += rays.size();
     RTCIntersectContext ctx;
