@@ -318,7 +318,7 @@ void CertifiedIntersector::intersect(const Ray& ray, std::span<const std::uint32
       nearer = order < 0 || (order == 0 && prim < best.hit.prim);
     }
     if (!nearer) continue;
-    best.hit = Hit{c->t, prim, c->u, c->v};
+    best.hit = Hit{c->t + 0.0f, prim, c->u, c->v};  // + 0: a zero t is +0 (docs/exact-leaf-test.md, "Hits beyond the float range")
     best.t_lo = c->t_lo;
     best.t_hi = c->t_hi;
     best.on = c->on;

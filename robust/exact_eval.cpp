@@ -4,10 +4,12 @@
 /// multiplies doubles exactly. Every value is a polynomial in the input floats
 /// (no division: the intersection point N/D is tested as sign(n·N + d·D)·sign(D)).
 #include <CGAL/FPU.h>
+#include <CGAL/Gmpq.h>
 #include <CGAL/Interval_nt.h>
 #include <CGAL/Mpzf.h>
 
 #include <cmath>
+#include <utility>
 
 #include "geometry/core/check.h"
 #include "robust/exact_side.h"
@@ -68,15 +70,40 @@ int exact_side_at(const TriangleSoup& soup, PlaneDef plane, const std::array<Pla
   return sign_of(v) * sign_of(h.den);
 }
 
+/// Whether Mpzf::to_interval is trusted for x: zero, or |x| in [2^-960, 2^960].
+/// CGAL 5.5's Mpzf::to_interval is not sound below the double range when the
+/// rounding mode is upward, as it is here (RoundingGuard): it scales by
+/// std::ldexp(1.0, e), which then rounds 2^-1216 up to the smallest subnormal
+/// instead of to 0, and CGAL takes that as an exact scale. 2^-1178 became the
+/// point [2^-1050, 2^-1050]; a cell vertex of a scene with coordinates near
+/// 2^-138 was placed 2^128 times too far out, and the build ended in an
+/// internal error (a differential review of 2026-12-07; regression test "bsp
+/// build: a scene with subnormal coordinates builds, verifies and traces
+/// exactly", tests/test_regressions.cpp). The verifier's intervals are of
+/// plane coefficients, at most degree 4 in the floats, so never below 2^-596.
+bool interval_trusted(const NT& x) {
+  if (x.is_zero()) return true;
+  const NT a = CGAL::abs(x);
+  return a >= NT(0x1p-960) && a <= NT(0x1p960);
+}
+
 IntervalBox exact_enclosure(const TriangleSoup& soup, const std::array<PlaneDef, 3>& def) {
   const Homogeneous h = intersect(soup, def);
   using IA = CGAL::Interval_nt<true>;  // self-protecting: callable in any rounding mode
   const IA den(h.den.to_interval());
   IntervalBox box;
   for (int i = 0; i < 3; ++i) {
-    const IA x = IA(h.num[i].to_interval()) / den;
-    box.lo[i] = x.inf();
-    box.hi[i] = x.sup();
+    std::pair<double, double> x;
+    if (interval_trusted(h.den) && interval_trusted(h.num[i])) {
+      const IA q = IA(h.num[i].to_interval()) / den;
+      x = {q.inf(), q.sup()};
+    } else {
+      // The coordinate itself is in range (a vertex of a cell of float
+      // planes): take the quotient exactly and let MPFR round it outward.
+      x = CGAL::to_interval(CGAL::Gmpq(h.num[i]) / CGAL::Gmpq(h.den));
+    }
+    box.lo[i] = x.first;
+    box.hi[i] = x.second;
   }
   return box;
 }

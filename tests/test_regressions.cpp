@@ -20,10 +20,13 @@
 #include "builder/kd/kd_build.h"
 #include "builder/kd/kd_file.h"
 #include "builder/tree_file.h"
+#include "verify/verify.h"
 #include "verify/verify_file.h"
 #include "robust/certified_intersector.h"
+#include "robust/degenerate.h"
 #include "robust/exact_tracer.h"
 #include "traverse/brute_force.h"
+#include "traverse/simd/cpu_features.h"
 #include "stiff_util.h"
 #include "test_util.h"
 
@@ -366,5 +369,160 @@ TEST_CASE("bvh8: a finite scene wider than the float range of its box areas buil
         CHECK(got.t == want.t);
       }
     }
+  }
+}
+
+// Found by a differential review (2026-12-07) on far_1e7's grazing rays: the
+// exact reference rounded t by checking CGAL's double estimate and its two
+// float neighbours, but a lazy number's estimate comes from its interval and
+// was 12 floats off here, so every exact mode reported t 12 ulps from the
+// nearest float of the exact t. The rational t is 0.8309395062579203...
+TEST_CASE("exact reference: t is the nearest float on a far grazing ray", "[regression]") {
+  TriangleSoup s;
+  add_tri(s, {10000043.0f, -58.7785301f, 68.8190918f}, {10000035.0f, -51.6121635f, 78.3451691f},
+          {10000030.0f, -64.741188f, 70.2309799f});
+  const Ray r = ray_of({10000052.0f, -69.82167053222656f, 55.723453521728516f},
+                       {-16.0f, 14.334415435791016f, 19.050052642822266f});
+  const float want = 0.830939531326294f;  // the nearest float of the rational t, by Python's Fraction
+  const ExactTracer exact(s);
+  CHECK(exact.trace(r).prim == 0);
+  CHECK(exact.trace(r).t == want);
+  for (const std::string& name : accel_names()) {
+    if (!accel_info(name).certified) continue;
+    CAPTURE(name);
+    const std::unique_ptr<Accelerator> t = make_tracer(name, s, AccelOptions{});
+    const Hit h = t->trace(r);
+    CHECK(h.prim == 0);
+    CHECK(h.t == want);
+  }
+}
+
+// Found by a differential review (2026-12-07): with tnear = -inf, the any-hit
+// shortcut of the double stage took a hit whose t enclosure reached below
+// -FLT_MAX as an occluder, while the nearest-hit query (rightly) missed: the
+// line meets this 2^124-wide triangle at t = -2^128, which rounds to -inf.
+TEST_CASE("occluded: a hit rounding to -inf does not occlude", "[regression]") {
+  TriangleSoup s;
+  add_tri(s, {-0x1p123f, -0x1p123f, 0x1p100f}, {0x1p123f, -0x1p123f, 0x1p100f}, {0, 0x1p123f, 0x1p100f});
+  const float inf = std::numeric_limits<float>::infinity();
+  Ray r = ray_of({0, 0, 0}, {0, 0, -0x1p-28f});
+  r.tnear = -inf;
+  const ExactTracer exact(s);
+  REQUIRE(!exact.trace(r).hit());
+  for (const std::string& name : accel_names()) {
+    if (name.rfind("embree", 0) == 0) continue;  // Embree refuses tnear < 0 (docs/api.md)
+    CAPTURE(name);
+    const std::unique_ptr<Accelerator> t = make_tracer(name, s, AccelOptions{});
+    CHECK(!t->trace(r).hit());
+    CHECK(!t->occluded(r));
+  }
+}
+
+// Found by a differential review (2026-12-07): one exact mode reported a zero
+// t as -0 and another as +0, so the hit files differed byte for byte. The
+// exact t has no sign of zero; every exact mode writes +0.
+TEST_CASE("exact modes: a hit at t = 0 is +0", "[regression]") {
+  TriangleSoup s;
+  add_tri(s, {-1, -1, 0}, {3, -1, 0}, {-1, 3, 0});
+  for (const Vec3f dir : {Vec3f{0, 0, 1}, Vec3f{0, 0, -1}, Vec3f{0.5f, 0.25f, -1}}) {
+    const Ray r = ray_of({0.25f, 0.25f, 0}, dir);
+    const ExactTracer exact(s);
+    CHECK(exact.trace(r).prim == 0);
+    CHECK(!std::signbit(exact.trace(r).t));
+    CHECK(exact.trace(r).t == 0);
+    for (const std::string& name : accel_names()) {
+      if (!accel_info(name).certified) continue;
+      CAPTURE(name, dir.z);
+      const std::unique_ptr<Accelerator> t = make_tracer(name, s, AccelOptions{});
+      const Hit h = t->trace(r);
+      CHECK(h.prim == 0);
+      CHECK(h.t == 0);
+      CHECK(!std::signbit(h.t));
+    }
+  }
+}
+
+// Found by a differential review (2026-12-07): the kd traversal lost hits
+// when (s - o) overflowed float for a split or root-box plane s: a plane at
+// x = -3.4e38 seen from x = 1e38 along d = -1e8 is crossed at t = 4.4e30, but
+// (s - o) = -4.4e38 became -inf, put the crossing at +inf and emptied the
+// ray's interval (a shadow-ray shape with tfar = 1e31, and tnear = -5e30
+// behind). Such axes now cull nothing (detail::kd_reciprocal), in single rays
+// and in packets alike.
+TEST_CASE("kd: a crossing whose (s - o) overflows loses no hit", "[regression]") {
+  const float M = 3.4e38f;
+  for (const int count : {1, 2}) {  // one triangle: the root clip; two: a split between them too
+    CAPTURE(count);
+    TriangleSoup s;
+    add_tri(s, {-M, -1e38f, -1e38f}, {-M, 1e38f, -1e38f}, {-M, 0, 1e38f});
+    if (count == 2) add_tri(s, {0, -1, -1}, {0, 1, -1}, {0, 0, 1});
+    // The rays pass beside the small triangle (z = 5).
+    std::vector<Ray> ahead(16, ray_of({1e38f, 0.5f, 5}, {-1e8f, 0, 0})), behind(16, ray_of({1e38f, 0.5f, 5}, {1e8f, 0, 0}));
+    for (Ray& r : ahead) r.tfar = 1e31f;
+    for (Ray& r : behind) r.tnear = -5e30f, r.tfar = 0;
+    const ExactTracer exact(s);
+    const BruteForceTracer brute(s);
+    for (const std::string name : {"kd", "kd-float"}) {
+      CAPTURE(name);
+      const std::unique_ptr<Accelerator> t = make_tracer(name, s, AccelOptions{});
+      const Accelerator& ref = accel_info(name).certified ? static_cast<const Accelerator&>(exact) : brute;
+      for (const std::vector<Ray>* rays : {&ahead, &behind}) {
+        const Hit want = ref.trace((*rays)[0]);
+        if (accel_info(name).certified) REQUIRE(want.prim == 0);  // exact: t = +-4.4e30 on the far plane
+        CHECK(t->trace((*rays)[0]).prim == want.prim);
+        CHECK(t->occluded((*rays)[0]) == want.hit());
+        for (const int w : {1, 4, 8, 16}) {
+          if (w > 1 && int(detected_isa()) < int(isa_for_width(w))) continue;
+          CAPTURE(w);
+          std::vector<Hit> got(rays->size());
+          t->trace_batch(*rays, got, w);
+          for (const Hit& h : got) CHECK((h.prim == want.prim && h.t == want.t));
+        }
+      }
+    }
+  }
+}
+
+// Found by a differential review (2026-12-07): a scene whose coordinates are
+// all near 2^-138 (subnormal floats) ended the exact BSP build in an internal
+// error ("three stored planes that do not meet in a point"). CGAL 5.5's
+// Mpzf::to_interval returned a point interval 2^128 times too large for a
+// homogeneous coordinate near 2^-1300, so a cell vertex (a triangle corner)
+// was placed at (1, 2, 3) * 2^-12 instead of 2^-140, and a later split found
+// it on the wrong side. exact_enclosure now takes such quotients in Gmpq.
+TEST_CASE("bsp build: a scene with subnormal coordinates builds, verifies and traces exactly", "[regression]") {
+  const float grid[12][3] = {{0, 5, 1}, {1, 5, 0}, {1, 6, 2}, {3, 4, 2},   {3, 5, 2}, {4, 5, 2},
+                             {1, 2, 3}, {1, 2, 5}, {2, 2, 5}, {2, 1, 4.5f}, {4, 1, 6.5f}, {2, 1, 4}};
+  for (const int e : {0, -140}) {  // the same scene at scale 1 always built
+    CAPTURE(e);
+    TriangleSoup s;
+    for (const auto& g : grid) s.vertices.push_back({std::ldexp(g[0], e), std::ldexp(g[1], e), std::ldexp(g[2], e)});
+    s.triangles = {{5, 4, 3}, {6, 8, 7}, {2, 1, 0}, {9, 10, 11}};
+    classify_degenerate(s);
+    BspTree exact_tree;
+    REQUIRE_NOTHROW(exact_tree = build_bsp(s));
+    const std::string path = bsprt::test::temp_path("regression_subnormal.bsp");
+    write_bsp_file_with_flat(path, s, exact_tree, flatten_bsp(s, exact_tree));
+    const VerifyReport r = verify_bsp(s, read_verify_input(path, s));
+    INFO((r.failure ? r.failure->describe() : std::string("ok")));
+    CHECK(r.certified);
+    // Rays from points around the scene to every corner and triangle centre.
+    const ExactTracer exact(s);
+    const std::unique_ptr<Accelerator> bsp = make_tracer("bsp", s, AccelOptions{});
+    const float from[4][3] = {{-1, -1, -1}, {7, 8, 9}, {2.5f, 3, -4}, {-3, 9, 2}};
+    int hits = 0;
+    for (const auto& f : from)
+      for (std::uint32_t t = 0; t < s.size(); ++t)
+        for (int k = 0; k <= 3; ++k) {
+          const Vec3f o{std::ldexp(f[0], e), std::ldexp(f[1], e), std::ldexp(f[2], e)};
+          const Vec3f target = k < 3 ? s.corner(t, k)
+                                     : (s.corner(t, 0) + s.corner(t, 1) + s.corner(t, 2)) * (1.0f / 3.0f);
+          const Ray ray = ray_of(o, target - o);
+          const Hit want = exact.trace(ray), got = bsp->trace(ray);
+          hits += want.hit();
+          CHECK(got.prim == want.prim);
+          CHECK(got.t == want.t);
+        }
+    CHECK(hits > 40);  // most of the 64 rays hit something
   }
 }

@@ -405,9 +405,12 @@ template <bool kAnyHit = false, class Fr, class TStage, class Open>
   double lo, hi;
   Stage ts = tstage(t, lo, hi);
   // Any hit (occluded): a t certainly in [tnear, tfar] will do, rounded or
-  // not; only a hit whose enclosure reaches past the float range stays open.
+  // not; only a hit whose enclosure reaches past the float range, at either
+  // end, stays open (a negative t below -FLT_MAX is as much a miss as a
+  // positive one above it: found by a review of 2026-12-07, with tnear = -inf).
   if constexpr (kAnyHit)
-    if (ts == Stage::Open && double_t_range(fr(), ray, tri, lo, hi) == Stage::Hit && std::isfinite(float(hi)))
+    if (ts == Stage::Open && double_t_range(fr(), ray, tri, lo, hi) == Stage::Hit && std::isfinite(float(lo)) &&
+        std::isfinite(float(hi)))
       ts = Stage::Hit, t = float(hi);
   if (ts == Stage::Miss) {
     ++tests, rules += rule;
@@ -434,7 +437,7 @@ template <bool kAnyHit = false, class Fr, class TStage, class Open>
   }
   ++tests, rules += rule;
   if (!nearer) return;
-  best.hit = Hit{t, prim, 0.0f, 0.0f};
+  best.hit = Hit{t + 0.0f, prim, 0.0f, 0.0f};  // a zero t is +0 in every exact mode, as the exact reference reports it
   stage_barycentrics(sw.w, best.hit.u, best.hit.v);
   best.t_lo = lo;
   best.t_hi = hi;

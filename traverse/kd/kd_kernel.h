@@ -4,6 +4,7 @@
 /// and the per-ISA packet kernels (kd_packet.inl) share, the interval widening
 /// constants both must use identically, and the kernel entry points.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -33,9 +34,22 @@ inline constexpr float kKdTHi = 1.0f + 0x1p-21f;
 /// whole interval), as in the BSP's setup (bsp_kernel.h, ray_setup_core).
 /// Regression test "kd and exact packets: a subnormal direction component
 /// loses no hit" (tests/test_bsp_traverse.cpp).
-inline float kd_reciprocal(float d) {
-  return (d == 0.0f || std::fabs(d) >= 0x1p-126f) ? 1.0f / d : std::numeric_limits<float>::quiet_NaN();
+///
+/// NaN too when (s - o) could overflow for a split s in the root box:
+/// |o| + reach >= 2^127, reach = max(|lo|, |hi|) of the root box on that axis
+/// (kd_reach). An overflowed difference is ±inf where the crossing is finite
+/// (a plane at -3.4e38 seen from 1e38 is crossed at t = 4.4e30 by a ray with
+/// d = -1e8) and put the ray's whole interval on one side. The float sum
+/// errs by half an ulp, far inside the factor of two to the overflow
+/// threshold. Regression test "kd: a crossing whose (s - o) overflows loses
+/// no hit" (tests/test_regressions.cpp).
+inline float kd_reciprocal(float d, float o, float reach) {
+  const bool normal_or_zero = d == 0.0f || std::fabs(d) >= 0x1p-126f;
+  return normal_or_zero && std::fabs(o) + reach < 0x1p127f ? 1.0f / d : std::numeric_limits<float>::quiet_NaN();
 }
+
+/// max(|lo[k]|, |hi[k]|) of the root box: a bound on |s| for every split s.
+inline float kd_reach(const Box3f& b, int k) { return std::max(std::fabs(b.lo[k]), std::fabs(b.hi[k])); }
 
 /// Raw pointers into a KdTracer, for kernels that must not instantiate std::
 /// templates compiled for their ISA.

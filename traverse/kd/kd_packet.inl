@@ -132,7 +132,9 @@ void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3],
   vfloat<W> inv[3], tmin = r.tnear, tmax = r.tfar;
   for (int k = 0; k < 3; ++k) {  // detail::kd_reciprocal per lane; padding lanes: inf, never active
     const vmask<W> normal_or_zero = (r.dir[k] == 0.0f) | (abs<W>(r.dir[k]) >= 0x1p-126f);
-    inv[k] = select<W>(normal_or_zero, 1.0f / r.dir[k], splat<W>(std::numeric_limits<float>::quiet_NaN()));
+    const vmask<W> no_overflow = abs<W>(o[k]) + detail::kd_reach(v.bounds, k) < 0x1p127f;
+    inv[k] = select<W>(normal_or_zero & no_overflow, 1.0f / r.dir[k],
+                       splat<W>(std::numeric_limits<float>::quiet_NaN()));
   }
   for (int k = 0; k < 3; ++k) {  // clip_root
     const vfloat<W> t0 = (v.bounds.lo[k] - o[k]) * inv[k], t1 = (v.bounds.hi[k] - o[k]) * inv[k];

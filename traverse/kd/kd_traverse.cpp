@@ -26,7 +26,8 @@ using detail::StackEntry;
 /// A zero direction component gives inv = +-inf: outside the slab both t are
 /// the same infinity (empty), inside they are -inf/+inf (no constraint), on
 /// the slab's plane 0 * inf = NaN, which the selects ignore. A subnormal
-/// component gives inv = NaN (detail::kd_reciprocal): that slab does not clip.
+/// component gives inv = NaN (detail::kd_reciprocal), as does an origin so far
+/// out that (b - o) could overflow: that slab does not clip.
 inline void clip_root(const Box3f& b, const float o[3], const float inv[3], const bool neg[3],
                       float& tmin, float& tmax) {
   for (int k = 0; k < 3; ++k) {
@@ -127,8 +128,9 @@ Hit trace_single(const KdView& v, const Ray& ray, RayCounters* c) {
   const WatertightRay wr = watertight_precompute(ray);
   if (!wr.valid) return hit;
   const float o[3] = {ray.org.x, ray.org.y, ray.org.z};
-  const float inv[3] = {detail::kd_reciprocal(ray.dir.x), detail::kd_reciprocal(ray.dir.y),
-                        detail::kd_reciprocal(ray.dir.z)};
+  const float inv[3] = {detail::kd_reciprocal(ray.dir.x, o[0], detail::kd_reach(v.bounds, 0)),
+                        detail::kd_reciprocal(ray.dir.y, o[1], detail::kd_reach(v.bounds, 1)),
+                        detail::kd_reciprocal(ray.dir.z, o[2], detail::kd_reach(v.bounds, 2))};
   const bool neg[3] = {std::signbit(ray.dir.x), std::signbit(ray.dir.y), std::signbit(ray.dir.z)};
   float tmin = ray.tnear, tmax = ray.tfar;
   clip_root(v.bounds, o, inv, neg, tmin, tmax);
