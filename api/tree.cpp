@@ -7,6 +7,7 @@
 
 #include <chrono>
 
+#include "builder/accel_factory.h"
 #include "builder/bsp/bsp_build.h"
 #include "builder/bsp/bsp_flat_io.h"
 #include "builder/bsp/bsp_flatten.h"
@@ -123,8 +124,9 @@ Certificate verify_kd(const TriangleSoup& soup, const TreeFileReader& file) {
   return c;
 }
 
-Certificate verify_bsp_tree(const TriangleSoup& soup, const TreeFileReader& file, const VerifyOptions& options) {
-  const VerifyInput in = read_verify_input(file, soup);
+Certificate verify_bsp_tree(const TriangleSoup& soup, const std::shared_ptr<const TreeFileReader>& file,
+                            const VerifyOptions& options) {
+  const VerifyInput in = read_verify_input(*file, soup);
   VerifyConfig internal;
   internal.threads = options.threads;
   internal.strict_extras = options.strict;
@@ -141,6 +143,11 @@ Certificate verify_bsp_tree(const TriangleSoup& soup, const TreeFileReader& file
     c.triangle = r.failure->triangle;
     c.witness = r.failure->witness;
   }
+  if (c.certified)
+    if (const std::string problem = bsp_tree_load_problem(soup, file); !problem.empty()) {
+      c.certified = false;
+      c.failure = "the tree is exact, but bsprt's tracers refuse the file: " + problem;
+    }
   return c;
 }
 
@@ -151,9 +158,9 @@ Certificate verify(const Scene& scene, const Tree& tree, const VerifyOptions& op
     throw UsageError("verify: the tree was built for another scene (fingerprint mismatch)");
   check_threads(options.threads, "VerifyOptions::threads");
   const auto t0 = Clock::now();
-  const TreeFileReader& file = *tree.file();
+  const std::shared_ptr<const TreeFileReader> file = tree.file();
   auto run = [&] {
-    return file.kind() == TreeKind::Kd ? verify_kd(scene.soup(), file) : verify_bsp_tree(scene.soup(), file, options);
+    return file->kind() == TreeKind::Kd ? verify_kd(scene.soup(), *file) : verify_bsp_tree(scene.soup(), file, options);
   };
   Certificate c = options.threads > 0 ? tbb::task_arena(options.threads).execute(run) : run();
   c.seconds = std::chrono::duration<double>(Clock::now() - t0).count();

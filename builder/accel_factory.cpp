@@ -240,4 +240,17 @@ std::unique_ptr<Accelerator> make_tracer(const std::string& accel, const Triangl
   return info.make(soup, options);
 }
 
+std::string bsp_tree_load_problem(const TriangleSoup& soup, std::shared_ptr<const TreeFileReader> file) {
+  AccelOptions options;
+  options.tree_file = std::move(file);
+  try {
+    make_tracer("bsp-float", soup, options);  // the loader and BspTracer's checks, as `trace --tree` runs them
+  } catch (const std::logic_error& e) {        // UsageError, and the trees' own validation
+    return e.what();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return {};
+}
+
 }  // namespace bsprt

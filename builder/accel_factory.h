@@ -81,4 +81,14 @@ std::vector<std::string> accel_names();
 std::unique_ptr<Accelerator> make_tracer(const std::string& accel, const TriangleSoup& soup,
                                          const AccelOptions& options = {});
 
+/// Why the tracers refuse the BSP tree file `file` for `soup`, or "" when they
+/// load it. The exact certificate (verify/) checks the geometry, independently
+/// of the loaders, and not their layout rules (each leaf-list entry used once,
+/// normals of unit length, depth below kBspMaxDepth, ...): `bsprt verify` and
+/// bsprt::verify run this after it, so that CERTIFIED also means the file can
+/// be traced. Found by a review (2026-12-07) that made verify certify files
+/// `bsprt trace --tree` refused; regression test "verify: a certified BSP file
+/// the tracers refuse is not certified" (tests/test_regressions.cpp).
+std::string bsp_tree_load_problem(const TriangleSoup& soup, std::shared_ptr<const TreeFileReader> file);
+
 }  // namespace bsprt

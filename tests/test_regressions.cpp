@@ -526,3 +526,33 @@ TEST_CASE("bsp build: a scene with subnormal coordinates builds, verifies and tr
     CHECK(hits > 40);  // most of the 64 rays hit something
   }
 }
+
+// Found by an adversarial review of the verifier (2026-12-07): `bsprt verify`
+// certified BSP files that `bsprt trace --tree` then refused (an unused extra
+// entry in the flat leaf lists, normals scaled by 1/2, ...). The certificate
+// checks the geometry, independently of the loaders; CERTIFIED now also means
+// that the tracers load the file (bsp_tree_load_problem).
+TEST_CASE("verify: a certified BSP file the tracers refuse is not certified", "[regression]") {
+  const TriangleSoup soup = make_default_scene();
+  const BspTree exact = build_bsp(soup);
+  const FlatBspTree good = flatten_bsp(soup, exact);
+  const std::string path = bsprt::test::temp_path("regression_verify_loadable.bsp");
+  write_bsp_file_with_flat(path, soup, exact, good);
+  REQUIRE(bsp_tree_load_problem(soup, std::make_shared<const TreeFileReader>(path)).empty());
+  CliRun ok = bsprt_cli("verify default " + path + " --threads 1");
+  CHECK(ok.status == 0);
+  CHECK(ok.output.find("CERTIFIED") != std::string::npos);
+
+  FlatBspTree extra = good;
+  extra.prims.push_back(0);  // listed by no leaf: the geometry is untouched
+  write_bsp_file_with_flat(path, soup, exact, extra);
+  REQUIRE(verify_bsp(soup, read_verify_input(path, soup)).certified);  // the geometric certificate alone
+  CHECK(!bsp_tree_load_problem(soup, std::make_shared<const TreeFileReader>(path)).empty());
+  CliRun bad = bsprt_cli("verify default " + path + " --threads 1");
+  CHECK(bad.status == 1);
+  CHECK(bad.output.find("CERTIFIED") == std::string::npos);
+  CHECK(bad.output.find("the tree is exact, but bsprt's tracers refuse the file") != std::string::npos);
+  AccelOptions from_file;
+  from_file.tree_path = path;
+  CHECK_THROWS(make_tracer("bsp", soup, from_file));  // what `bsprt trace --tree` runs
+}
