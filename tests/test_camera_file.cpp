@@ -3,10 +3,12 @@
 #include <catch2/catch.hpp>
 
 #include <fstream>
+#include <vector>
 #include <string>
 
 #include "bsprt/error.h"
 #include "geometry/io/camera_file.h"
+#include "geometry/scenes/camera.h"
 #include "test_util.h"
 
 using namespace bsprt;
@@ -83,5 +85,38 @@ TEST_CASE("camera file: the interior cameras see walls all around", "[camera][cl
     const double hit = std::stod(t.output.substr(at + 7));
     INFO(name << ": " << t.output);
     CHECK(hit >= least * 64 * 48);
+  }
+}
+
+// Found by an adversarial review of the readers (2026-12-07): misspelt keys
+// and repeated keys were ignored, and cameras whose basis overflowed in float
+// passed the checks and made NaN rays (far points) or identical rays (a huge
+// up vector).
+TEST_CASE("camera file: unknown and repeated keys are errors, and far or huge vectors make usable rays",
+          "[camera][regression]") {
+  const std::string ok = R"({"name": "a", "vp": [0, 0, 5], "vi": [0, 0, 0], "vu": [0, 1, 0], "fov": 40)";
+  CHECK_NOTHROW(read_camera_file(write_temp("cam_ok.json", R"({"cameras": [)" + ok + "}]}")));
+  CHECK_THROWS_WITH(read_camera_file(write_temp("cam_typo.json", R"({"cameras": [)" + ok + R"(, "fov_deg": 30}]})")),
+                    Catch::Contains("unknown key \"fov_deg\""));
+  CHECK_THROWS_WITH(read_camera_file(write_temp("cam_dup.json", R"({"cameras": [)" + ok + R"(, "fov": 170}]})")),
+                    Catch::Contains("the key \"fov\" is given twice"));
+  CHECK_THROWS_WITH(read_camera_file(write_temp("cam_top.json", R"({"camera": 1, "cameras": [)" + ok + "}]}")),
+                    Catch::Contains("unknown top-level key \"camera\""));
+  CHECK_THROWS_WITH(read_camera_file(write_temp("cam_what.json", R"({"cameras": [)" + ok + R"(, "what": 3}]})")),
+                    Catch::Contains("\"what\" must be a string"));
+
+  for (const Camera cam : {Camera{{0.3f, 0.3f, 3e38f}, {0.3f, 0.3f, -3e38f}, {0, 1, 0}, 40.0f},
+                           Camera{{0, 0, 5}, {0, 0, 0}, {0, 1e30f, 0}, 40.0f},
+                           Camera{{-3e38f, 0, 0}, {3e38f, 1, 0}, {0, 0, 3e38f}, 60.0f}}) {
+    REQUIRE(camera_problem(cam).empty());
+    const CameraRays rays(cam, 4, 4);
+    std::vector<Vec3f> dirs;
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) {
+        const Ray r = rays.ray(x, y);
+        CHECK(is_valid(r));
+        dirs.push_back(normalize(r.dir));
+      }
+    CHECK(length(dirs.front() - dirs.back()) > 0.1f);  // the corners of the image look different ways
   }
 }

@@ -168,7 +168,7 @@ TEST_CASE("cli: trace --all-hits refuses options it would ignore and prints JSON
   const Run j = bsprt_cli("trace " + cube + " " + rays + out + " --all-hits --json");
   INFO(j.output);
   CHECK(j.status == 0);
-  CHECK(has(j, "{\"all_hits\": true, \"rays\": 40, \"crossings\": "));
+  CHECK(has(j, "{\"all_hits\": true, \"rays\": 40, \"invalid_rays\": 0, \"crossings\": "));
 }
 
 TEST_CASE("cli: compare reports a wrong t on the right triangle, refuses malformed records and tolerances",
@@ -177,8 +177,14 @@ TEST_CASE("cli: compare reports a wrong t on the right triangle, refuses malform
   const float inf = std::numeric_limits<float>::infinity();
   const std::vector<Hit> reference = {Hit{1.0f, 0, 0.25f, 0.25f}, Hit{}, Hit{2.0f, 3, 0.5f, 0.0f}};
   write_hits(ref, reference);
+  // write_hits refuses malformed records: write valid ones, then put the
+  // tested records' bytes in place (records are the file's last bytes).
   const auto compare = [&](std::vector<Hit> tested, const std::string& extra = "") {
-    write_hits(got, tested);
+    write_hits(got, std::vector<Hit>(tested.size()));
+    std::fstream f(got, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(-std::streamoff(tested.size() * sizeof(Hit)), std::ios::end);
+    f.write(reinterpret_cast<const char*>(tested.data()), std::streamsize(tested.size() * sizeof(Hit)));
+    f.close();
     return bsprt_cli("compare " + ref + " " + got + " " + extra);
   };
   CHECK(compare(reference).status == 0);
@@ -261,4 +267,25 @@ TEST_CASE("cli: gen refuses ray options without --rays-out, and PLY layouts Open
           "property float z\nelement face 1\nproperty uchar flags\nproperty list uchar int vertex_indices\n"
           "end_header\n0 0 0\n1 0 0\n0 1 0\n7 3 0 1 2\n",
           ":7: PLY face property 'flags' before vertex_indices is not supported");
+}
+
+// Found by an adversarial review of the readers (2026-12-07): invalid rays
+// became misses without being counted anywhere.
+TEST_CASE("cli: trace counts and reports invalid rays", "[cli][regression]") {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  std::vector<Ray> rays(5);
+  for (Ray& r : rays) r.org = {0, 0, -5}, r.dir = {0, 0, 1};
+  rays[1].dir = {nan, 0, 1};
+  rays[2].dir = {0, 0, 0};
+  rays[3].org = {inf, 0, 0};
+  rays[4].tnear = 2, rays[4].tfar = 1;
+  const std::string path = temp_path("cli_invalid.rays"), hits = temp_path("cli_invalid.hits");
+  write_rays(path, rays);
+  const Run t = bsprt_cli("trace default " + path + " -o " + hits + " --accel brute");
+  CHECK(t.status == 0);
+  CHECK(t.output.find("note: 4 rays of " + path + " are not valid") != std::string::npos);
+  const Run j = bsprt_cli("trace default " + path + " -o " + hits + " --accel brute --json");
+  CHECK(j.output.find("\"invalid_rays\": 4") != std::string::npos);
+  const Run ok = bsprt_cli("trace default " + path + " -o " + hits + " --all-hits --json");
+  CHECK(ok.output.find("\"invalid_rays\": 4") != std::string::npos);
 }

@@ -604,3 +604,78 @@ TEST_CASE("TriangleSoup bounds, degenerate_count and append", "[soup]") {
   CHECK(a.degenerate_count() == 1);
   CHECK(a.bounds().hi == Vec3f(1, 1, 1));
 }
+
+// Found by an adversarial review of the readers (2026-12-07); each was a hang,
+// a silent loss or a misleading error.
+TEST_CASE("PLY: an element of records with no properties is an error, not a 2^31-step loop", "[load][regression]") {
+  std::string b =
+      "ply\nformat binary_little_endian 1.0\nelement junk 2147483647\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const Vec3f& p : {P0, P1, P2}) put_f32(b, p.x), put_f32(b, p.y), put_f32(b, p.z);
+  put_u8(b, 3), put_i32(b, 0), put_i32(b, 1), put_i32(b, 2);
+  require_error(write_file("noprops.ply", b), ":3: PLY element 'junk' declares 2147483647 records but no properties");
+}
+
+TEST_CASE("PLY binary: a face past the declared count is an error even when its bytes are whitespace",
+          "[load][regression]") {
+  const auto file = [](int declared) {
+    std::string b = "ply\nformat binary_little_endian 1.0\nelement vertex 14\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face " + std::to_string(declared) +
+                    "\nproperty list uchar uchar vertex_indices\nend_header\n";
+    for (int v = 0; v < 14; ++v) put_f32(b, float(v)), put_f32(b, float(v * v % 7)), put_f32(b, float(v % 3));
+    for (int k : {3, 0, 1, 2}) put_u8(b, std::uint8_t(k));
+    for (int k : {9, 10, 11, 12, 13, 9, 10, 11, 12, 13}) put_u8(b, std::uint8_t(k));  // 9 corners: tab, LF, VT, FF, CR
+    return b;
+  };
+  require_error(write_file("ws_tail.ply", file(1)), "10 bytes after the last element");
+  CHECK(load_mesh(write_file("ws_tail_ok.ply", file(2))).size() == 1 + 7);  // the 9-gon is 7 triangles
+}
+
+TEST_CASE("PLY binary: property types OpenMesh cannot convert are skipped or named", "[load][regression]") {
+  // A vertex property 's' (a texture coordinate to OpenMesh) of type short,
+  // list counts of type int32 (which OpenMesh's header parser refuses) and
+  // ushort indices: OpenMesh printed to std::cerr and misread the rest.
+  std::string b =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nproperty short s\nproperty uchar red\nelement face 2\n"
+      "property list int32 ushort vertex_indices\nproperty double red\nend_header\n";
+  for (const Vec3f& p : {P0, P1, P2, P3}) put_f32(b, p.x), put_f32(b, p.y), put_f32(b, p.z), put_u8(b, 7), put_u8(b, 0), put_u8(b, 200);
+  const auto put_u16 = [&b](int v) { put_u8(b, std::uint8_t(v & 255)), put_u8(b, std::uint8_t(v >> 8)); };
+  put_i32(b, 3), put_u16(0), put_u16(1), put_u16(2), put_f64(b, 0.5);
+  put_i32(b, 3), put_u16(0), put_u16(2), put_u16(3), put_f64(b, 0.25);
+  const TriangleSoup s = load_mesh(write_file("types.ply", b));
+  REQUIRE(s.size() == 2);
+  check_triangle(s, 0, P0, P1, P2);
+  check_triangle(s, 1, P0, P2, P3);
+  std::string c =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty int x\nproperty int y\nproperty int z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (int v : {0, 0, 0, 1, 0, 0, 0, 1, 0}) put_i32(c, v);
+  put_u8(c, 3), put_i32(c, 0), put_i32(c, 1), put_i32(c, 2);
+  require_error(write_file("intcoords.ply", c), "binary PLY vertex coordinate 'x' of type int is not supported");
+}
+
+TEST_CASE("OBJ: a CR inside a line and extra values on a v line are errors, colors and 1-value vt load",
+          "[load][regression]") {
+  require_error(write_file("mixcr.obj", "v 0 0 0\nv 1 0 0\rv 9 9 9\nv 0 1 0\nf -3 -2 -1\n"),
+                ":2: carriage return inside a line");
+  require_error(write_file("cr_only.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r"), ":1: carriage return inside a line");
+  require_error(write_file("vjoin.obj", "v 0 0 0 1 0 0 0 1 0\nf 1 1 1\n"), ":1: vertex 1 has 9 values");
+  require_error(write_file("vword.obj", "v 0 0 0 v\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), ":1: vertex 1: 'v' after the coordinates");
+  const TriangleSoup s = load_mesh(write_file(
+      "colors_vt.obj", "v 0 0 0 1 0 0\nv 1 0 0 0.5 0.5 0.5 1\nv 0 1 0 nan 0 0\nv 0 0 1 2\nvt 0.5\nvt nan 0\n"
+                       "f 1/1 2/2 3/1\nf 1 3 4\n"));
+  REQUIRE(s.size() == 2);
+  check_triangle(s, 0, P0, P1, P3);
+  check_triangle(s, 1, P0, P3, P4);
+}
+
+TEST_CASE("STL: corners closer than FLT_MIN stay apart, as in the other formats", "[load][regression]") {
+  const Vec3f tiny{1e-39f, 0, 0};
+  const std::vector<std::array<Vec3f, 3>> facets = {{P0, P1, P3}, {tiny, P1, P3}};
+  const TriangleSoup s = load_mesh(write_file("tiny_bin.stl", binary_stl(facets)));
+  REQUIRE(s.size() == 2);
+  CHECK(s.corner(1, 0).x == 1e-39f);
+  CHECK(!s.is_degenerate(1));
+  CHECK(s.degenerate_count() == 0);
+}

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -141,4 +142,19 @@ TEST_CASE("ray_io: a truncated large file reports sizes", "[ray_io]") {
   write_rays(p, sample_rays(100000));
   std::filesystem::resize_file(p, 3200000);
   expect_input_error([&] { read_rays(p); }, p, "expected 3200016 bytes for 100000 rays, file has 3200000");
+}
+
+// Found by an adversarial review of the readers (2026-12-07): write_hits wrote
+// records that read_hits refuses (t = NaN with a triangle).
+TEST_CASE("ray_io: write_hits refuses a record read_hits would refuse, and writes nothing", "[ray_io][regression]") {
+  const std::string path = test::temp_path("bad_record.hits");
+  std::remove(path.c_str());
+  std::vector<Hit> hits(2);
+  hits[0] = Hit{1.5f, 3, 0.25f, 0.25f};
+  hits[1] = Hit{std::numeric_limits<float>::quiet_NaN(), 2, 0.0f, 0.0f};
+  CHECK_THROWS_WITH(write_hits(path, hits), Catch::Contains("hit record 1 is"));
+  CHECK(!std::ifstream(path).good());
+  hits.pop_back();
+  write_hits(path, hits);
+  CHECK(read_hits(path).size() == 1);
 }

@@ -39,13 +39,30 @@ Vec3f vec_field(const std::string& path, const json& cam, const std::string& who
 std::vector<NamedCamera> read_camera_file(const std::string& path) {
   const std::string text = read_file_bytes(path, "camera file");
   json doc;
+  // A key given twice in one object: JSON leaves it open, nlohmann keeps the
+  // last one; a camera file that says fov twice is refused (review of
+  // 2026-12-07). The parser's callback sees each key of each object in order.
+  std::vector<std::vector<std::string>> keys;  // per open object
+  const auto no_duplicates = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) keys.emplace_back();
+    if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+    if (event == json::parse_event_t::key && !keys.empty()) {
+      const std::string k = parsed.get<std::string>();
+      if (std::find(keys.back().begin(), keys.back().end(), k) != keys.back().end())
+        throw InputError(path, "the key \"" + k + "\" is given twice in one object");
+      keys.back().push_back(k);
+    }
+    return true;
+  };
   try {
-    doc = json::parse(text);
+    doc = json::parse(text, no_duplicates);
   } catch (const json::parse_error& e) {
     throw InputError(path, line_of(text, e.byte > 0 ? e.byte - 1 : 0), std::string("not valid JSON: ") + e.what());
   }
   if (!doc.is_object() || !doc.contains("cameras") || !doc["cameras"].is_array())
     throw InputError(path, "expected an object with an array \"cameras\"");
+  for (const auto& [key, value] : doc.items())
+    if (key != "cameras") throw InputError(path, "unknown top-level key \"" + key + "\" (a camera file holds \"cameras\")");
   std::vector<NamedCamera> out;
   for (std::size_t i = 0; i < doc["cameras"].size(); ++i) {
     const json& c = doc["cameras"][i];
@@ -55,11 +72,18 @@ std::vector<NamedCamera> read_camera_file(const std::string& path) {
     NamedCamera nc;
     nc.name = c["name"].get<std::string>();
     who += " \"" + nc.name + "\"";
+    // A misspelt key ("fov_deg", "secne") was ignored, and the camera used a
+    // default or none at all.
+    static const char* const known[] = {"name", "scene", "what", "vp", "vi", "vu", "fov"};
+    for (const auto& [key, value] : c.items())
+      if (std::find(std::begin(known), std::end(known), key) == std::end(known))
+        throw InputError(path, who + ": unknown key \"" + key + "\" (the keys are name, scene, what, vp, vi, vu, fov)");
+    if (c.contains("what") && !c["what"].is_string()) throw InputError(path, who + ": \"what\" must be a string");
     if (c.contains("scene")) {
       if (!c["scene"].is_string()) throw InputError(path, who + ": \"scene\" must be a string");
       nc.scene = c["scene"].get<std::string>();
     }
-    if (c.contains("what") && c["what"].is_string()) nc.what = c["what"].get<std::string>();
+    if (c.contains("what")) nc.what = c["what"].get<std::string>();
     nc.camera.vp = vec_field(path, c, who, "vp");
     nc.camera.vi = vec_field(path, c, who, "vi");
     nc.camera.vu = vec_field(path, c, who, "vu");

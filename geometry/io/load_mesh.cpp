@@ -270,7 +270,16 @@ Polygons load_stl(const std::string& path, std::string& bytes, const LoadOptions
     return stl_from_scan(scan);
   }
   OpenMeshResult om = detail::openmesh_read(path, bytes, "stl", scan.binary);
-  return stl_from_openmesh(path, scan, om);
+  // OpenMesh's read is the cross-check of the pre-pass (every facet it keeps
+  // must be the file's). The corners themselves come from the pre-pass:
+  // OpenMesh merges corners closer than FLT_MIN, which moved (1e-39, 0, 0) to
+  // the origin and made a real triangle degenerate, while the same triangles
+  // from an OBJ kept their corners (review of 2026-12-07). Only bit-identical
+  // corners share a vertex.
+  Polygons checked = stl_from_openmesh(path, scan, om);
+  Polygons p = stl_from_scan(scan);
+  p.face_line = std::move(checked.face_line);
+  return p;
 }
 
 // ---------------------------------------------------------------------------

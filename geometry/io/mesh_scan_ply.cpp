@@ -41,7 +41,6 @@ struct PlyProperty {
   PlyType count_type;
   int axis = -1;           ///< 0..2 for x, y, z of the vertex element
   bool indices = false;    ///< vertex_indices of the face element
-  std::string decl;        ///< the declaration, normalized
 };
 
 struct PlyElement {
@@ -78,7 +77,6 @@ void add_property(const std::string& path, std::int64_t no, std::string_view lin
     throw InputError(path, no, "PLY property line must be 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
   if (e.name == "vertex" && !p.list) p.axis = p.name == "x" ? 0 : p.name == "y" ? 1 : p.name == "z" ? 2 : -1;
   p.indices = e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
-  p.decl = "property " + (p.list ? "list " + std::string(count_name) + " " : std::string()) + std::string(t) + " " + p.name;
   e.props.push_back(std::move(p));
 }
 
@@ -141,11 +139,37 @@ PlyHeader parse_ply_header(const std::string& path, const std::string& bytes) {
 /// declaration per line, without comments. OpenMesh 9.0's header parser loops
 /// forever (printing to omerr) on some malformed lines, e.g. a bad version;
 /// a canonical header keeps whatever we accepted within what it handles.
-std::string canonical_header(const PlyHeader& h) {
+///
+/// Within what OpenMesh handles means (measured on Debian's OpenMesh 9, all
+/// sixteen type names, binary and ascii; a review of 2026-12-07 found the
+/// gaps): only the vertex's x, y, z and the face's vertex_indices keep their
+/// names, every other property is renamed `bsprt_skip_N`, which OpenMesh
+/// skips by its size whatever its type (named s, t, u, v, nx or red with a
+/// type OpenMesh cannot convert, it printed to std::cerr and misread the rest);
+/// list count types are written as the one name of their size OpenMesh takes
+/// (uchar, uint16, int: it refuses int32, uint, short, char and the others).
+std::string canonical_header(const std::string& path, const PlyHeader& h) {
+  const auto count_name = [](const PlyType& t) { return t.size == 1 ? "uchar" : t.size == 2 ? "uint16" : "int"; };
+  const auto type_name = [](const PlyType& t) {
+    if (t.floating) return t.size == 4 ? "float" : "double";
+    static const char* names[2][5] = {{"", "uchar", "uint16", "", "uint"}, {"", "char", "short", "", "int"}};
+    return names[t.is_signed ? 1 : 0][t.size];
+  };
   std::string s = "ply\nformat " + h.format_name + " 1.0\n";
+  int skipped = 0;
   for (const PlyElement& e : h.elements) {
     s += "element " + e.name + " " + std::to_string(e.count) + "\n";
-    for (const PlyProperty& p : e.props) s += p.decl + "\n";
+    for (const PlyProperty& p : e.props) {
+      if (p.axis >= 0 && h.format != PlyFormat::ascii && !p.type.floating)
+        throw InputError(path, e.line, "binary PLY vertex coordinate '" + p.name + "' of type " + type_name(p.type) +
+                                           " is not supported (OpenMesh, which reads PLY here, takes float or "
+                                           "double coordinates in binary files)");
+      s += "property ";
+      if (p.list) s += std::string("list ") + count_name(p.count_type) + " ";
+      s += type_name(p.type);
+      s += p.axis >= 0 || p.indices ? " " + p.name : " bsprt_skip_" + std::to_string(skipped++);
+      s += "\n";
+    }
   }
   return s + "end_header\n";
 }
@@ -156,6 +180,11 @@ std::string canonical_header(const PlyHeader& h) {
 void check_supported(const std::string& path, const PlyHeader& h, ElementScan& scan) {
   bool have_vertex = false, have_face = false;
   for (const PlyElement& e : h.elements) {
+    // Records of no bytes: a short header could make both passes loop 2^31
+    // times per element (a review of 2026-12-07: 728 bytes, 34 s).
+    if (e.props.empty() && e.count > 0)
+      throw InputError(path, e.line, "PLY element '" + e.name + "' declares " + std::to_string(e.count) +
+                                         " records but no properties");
     if (e.name == "vertex") {
       int axes = 0;
       for (const PlyProperty& p : e.props) axes += p.axis >= 0 ? 1 : 0;
@@ -264,10 +293,12 @@ void walk_binary(const std::string& path, const std::string& bytes, const PlyHea
       scan.coords.push_back(p);
     }
   }
-  // A newline or two after the data is harmless; anything else means the
-  // header's counts are smaller than what the file holds.
+  // A newline (LF or CR LF) after the data is harmless; anything else means
+  // the header's counts are smaller than what the file holds. Not more: a
+  // record of whitespace bytes (a face 9 10 11 ... as uchar) is data, and
+  // skipping it lost the face without a word (review of 2026-12-07).
   std::size_t rest = in.pos;
-  while (rest < bytes.size() && is_blank(bytes[rest])) ++rest;
+  while (rest < bytes.size() && rest < in.pos + 2 && is_blank(bytes[rest])) ++rest;
   if (rest != bytes.size())
     throw InputError(path, std::to_string(bytes.size() - in.pos) + " bytes after the last element the header declares "
                                                                  "(do the counts lie?)");
@@ -374,7 +405,7 @@ ElementScan scan_ply(const std::string& path, std::string& bytes) {
   ElementScan scan;
   check_supported(path, header, scan);
   scan.binary = header.format != PlyFormat::ascii;
-  scan.openmesh_header = canonical_header(header);
+  scan.openmesh_header = canonical_header(path, header);
   scan.body_offset = header.body;
   scan.coords.reserve(std::min<std::size_t>(scan.vertices, 1u << 24));
   if (scan.binary)

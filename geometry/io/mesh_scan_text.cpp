@@ -123,6 +123,22 @@ void scan_obj_vertex(const std::string& path, std::string& bytes, std::string_vi
       blank_out(bytes, tok, '0');
     }
   }
+  // After x y z: nothing, w, or a color r g b (a): numbers, as OpenMesh reads
+  // them. Anything else was ignored, and `v 1 0 0<CR>v 9 9 9` lost a vertex
+  // without a word (review of 2026-12-07).
+  int extra = 0;
+  for (std::string_view tok = next_token(line, i); !tok.empty() && tok[0] != '#'; tok = next_token(line, i)) {
+    float value = 0;
+    const NumberKind kind = parse_coordinate(tok, value);
+    if (kind == NumberKind::malformed)
+      throw InputError(path, line_no, "vertex " + std::to_string(vertex + 1) + ": " + quote(tok) +
+                                          " after the coordinates is not a number");
+    if (kind == NumberKind::nonfinite) blank_out(bytes, tok, '0');  // unused; OpenMesh would skip the line
+    ++extra;
+  }
+  if (extra == 2 || extra > 4)
+    throw InputError(path, line_no, "vertex " + std::to_string(vertex + 1) + " has " + std::to_string(3 + extra) +
+                                        " values; a `v` line holds x y z, then optionally w, or a color r g b (a)");
 }
 
 void scan_obj_face(const std::string& path, std::string_view line, std::size_t& i,
@@ -161,12 +177,21 @@ ObjScan scan_obj(const std::string& path, std::string& bytes) {
   LineCursor lines(bytes);
   std::string_view line;
   while (lines.next(line)) {
+    // A CR inside a line is an old Mac line end: neither pass would see the
+    // lines it separates (a CR-only file read as one line and had "no triangles").
+    if (line.find('\r') != std::string_view::npos)
+      throw InputError(path, lines.number(), "carriage return inside a line: CR-only line ends are not supported "
+                                             "(use LF or CR LF)");
     std::size_t i = 0;
     const std::string_view keyword = next_token(line, i);
     if (keyword == "v")
       scan_obj_vertex(path, bytes, line, i, lines.number(), scan);
     else if (keyword == "f")
       scan_obj_face(path, line, i, lines.number(), scan);
+    else if (keyword == "vt")
+      // Texture coordinates are not used. OpenMesh refuses a whole file over a
+      // `vt` with one value (legal OBJ) or a NaN, without a line: blank them.
+      blank_out(bytes, line, ' ');
     else if (keyword == "mtllib")
       // OpenMesh would open and read the named file (relative to whatever
       // folder its reader singleton last saw; with "/dev/zero" it reads until a

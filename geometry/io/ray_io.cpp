@@ -124,6 +124,11 @@ std::vector<Hit> read_hits(const std::string& path) {
 }
 
 void write_hits(const std::string& path, std::span<const Hit> hits) {
+  // What read_hits refuses is not written: a file this writes can be read
+  // back (Python's write_hits wrote t = NaN with a triangle; review of 2026-12-07).
+  for (std::size_t i = 0; i < hits.size(); ++i)
+    if (const char* why = hit_record_problem(hits[i]))
+      throw UsageError("write_hits: hit record " + std::to_string(i) + " is " + why + " (formats.md); not writing " + path);
   write_records(path, kHits, hits.data(), hits.size());
 }
 

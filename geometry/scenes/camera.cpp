@@ -7,22 +7,47 @@
 
 namespace bsprt {
 
+namespace {
+
+/// The camera's unit basis, made in double: for finite float fields nothing
+/// overflows or underflows there (vi - vp of points at +-3e38, a 1e30 up
+/// vector: in float these overflowed and gave NaN or identical rays; a review
+/// of 2026-12-07). Zero vectors when vp == vi or vu is parallel to the view.
+struct Basis {
+  Vec3d fwd, right, up;
+  double view_len2 = 0, side_len2 = 0;
+};
+
+Basis camera_basis(const Camera& cam) {
+  Basis b;
+  const Vec3d view = Vec3d(cam.vi) - Vec3d(cam.vp);
+  b.view_len2 = dot(view, view);
+  if (b.view_len2 == 0) return b;
+  b.fwd = normalize(view);
+  const Vec3d side = cross(b.fwd, Vec3d(cam.vu));
+  b.side_len2 = dot(side, side);
+  if (b.side_len2 == 0) return b;
+  b.right = normalize(side);
+  b.up = cross(b.right, b.fwd);
+  return b;
+}
+
+}  // namespace
+
 std::string camera_problem(const Camera& cam) {
   if (!is_finite(cam.vp)) return "vp (the position) is not finite";
   if (!is_finite(cam.vi)) return "vi (the point looked at) is not finite";
   if (!is_finite(cam.vu)) return "vu (the up vector) is not finite";
   if (!(cam.fov > 0.0f && cam.fov < 180.0f)) return "fov " + std::to_string(cam.fov) + " is not in (0, 180) degrees";
-  const Vec3f view = cam.vi - cam.vp;
-  if (dot(view, view) == 0.0f) return "vp and vi are the same point";
-  const Vec3f side = cross(view, cam.vu);
-  if (dot(side, side) == 0.0f) return "vu is parallel to the view direction (or zero)";
+  const Basis b = camera_basis(cam);
+  if (b.view_len2 == 0) return "vp and vi are the same point";
+  if (b.side_len2 == 0) return "vu is parallel to the view direction (or zero)";
   return "";
 }
 
 CameraRays::CameraRays(const Camera& cam, int width, int height) : org_(cam.vp) {
-  const Vec3f fwd = normalize(cam.vi - cam.vp);
-  const Vec3f right = normalize(cross(fwd, cam.vu));
-  const Vec3f up = cross(right, fwd);
+  const Basis b = camera_basis(cam);
+  const Vec3f fwd(b.fwd), right(b.right), up(b.up);
   const float half_h = std::tan(cam.fov * std::numbers::pi_v<float> / 360.0f);
   const float half_w = half_h * float(width) / float(height);
   du_ = right * (2.0f * half_w / float(width));
