@@ -344,7 +344,7 @@ void CertifiedIntersector::crossings(const Ray& ray, std::span<const std::uint32
     const std::array<Vec3f, 3> tri = soup_.corners(prim);
     const std::optional<Candidate> c = test_one(ray, fr, tri, st, true);
     if (!c) continue;
-    out.push_back({prim, c->t, c->sign});
+    out.push_back({prim, c->t + 0.0f, c->sign});  // a zero t is +0, as in intersect (review of 2026-12-07)
   }
   if (st.exact) fallbacks_.fetch_add(st.exact, std::memory_order_relaxed);
   if (counters) {

@@ -35,7 +35,13 @@ PointSide InsideQuery::side(const Vec3f& p, RayCounters* counters) const {
   if (exact_.on_surface(p)) return PointSide::OnSurface;
   Ray r;
   r.org = p;
-  r.dir = ray_direction();
+  // Scaled by 2^64 (exactly: the same line and crossings, t / 2^64), so that
+  // no crossing's t can round beyond the float range, where the convention of
+  // exact-leaf-test.md drops it: a point near -FLT_MAX left one of the two
+  // crossings of a cube 1e27 wide and was "inside" (review of 2026-12-07).
+  // Distances between floats are below 2^130, so every t is below 2^66; a t
+  // that rounds to 0 is still a crossing (its exact t is > 0).
+  r.dir = ray_direction() * 0x1p64f;
   r.tnear = 0.0f;
   std::vector<std::uint32_t> candidates;
   exact_.touched(r, candidates);

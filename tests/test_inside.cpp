@@ -259,3 +259,53 @@ TEST_CASE("trace --all-hits equals exact brute-force crossings, and --occluded e
 }
 
 }  // namespace bsprt
+
+namespace bsprt {
+
+// Found by a differential review (2026-12-07): the parity ray from a point
+// near -FLT_MAX entered this cube at a finite t and left it at a t rounding to
+// +inf, which the nearest-hit convention drops: one crossing, "inside".
+TEST_CASE("inside: a point near -FLT_MAX outside a small cube is outside", "[inside][regression]") {
+  // The cube (corners at +-0.5, scaled to half-size 1e27) is centred where
+  // the parity ray from p reaches t = FLT_MAX + half an ulp, where a t starts
+  // to round to +inf: it enters below that t and leaves above it.
+  const float M = std::numeric_limits<float>::max();
+  const Vec3f p{-M, -0.375f * M, -0.1875f * M};
+  const double threshold = 0x1.ffffffp127;
+  const Vec3f centre{float(double(p.x) + threshold), float(double(p.y) + threshold * 0.375),
+                     float(double(p.z) + threshold * 0.1875)};
+  TriangleSoup cube = load_mesh(test::scene_path("cube.obj"));
+  for (Vec3f& v : cube.vertices) v = centre + v * 2e27f;
+  classify_degenerate(cube);
+  const InsideQuery q(cube);
+  CHECK(q.side(centre) == PointSide::Inside);
+  CHECK(q.side(p) == PointSide::Outside);
+  CHECK(q.side({-M, 0, 0}) == PointSide::Outside);
+  CHECK(q.side({M, M, M}) == PointSide::Outside);
+}
+
+// Found by the same review: --all-hits wrote t = -0 for a ray from a vertex,
+// where the nearest-hit query writes +0.
+TEST_CASE("crossings: a crossing at t = 0 is +0", "[inside][regression]") {
+  TriangleSoup cube = load_mesh(test::scene_path("cube.obj"));
+  classify_degenerate(cube);
+  const CertifiedIntersector cert(cube);
+  int zeros = 0;
+  for (const Vec3f& v : cube.vertices)
+    for (const Vec3f d : {Vec3f{-v.x, -v.y, -v.z}, Vec3f{-v.x, 0.25f * v.y, -0.5f * v.z}}) {
+      Ray r;
+      r.org = v, r.dir = d;
+      std::vector<std::uint32_t> all(cube.size());
+      for (std::uint32_t t = 0; t < cube.size(); ++t) all[t] = t;
+      std::vector<CertifiedIntersector::Crossing> out;
+      cert.crossings(r, all, out, nullptr);
+      for (const auto& c : out)
+        if (c.t == 0) {
+          ++zeros;
+          CHECK(!std::signbit(c.t));
+        }
+    }
+  CHECK(zeros > 0);
+}
+
+}  // namespace bsprt

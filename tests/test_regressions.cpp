@@ -556,3 +556,24 @@ TEST_CASE("verify: a certified BSP file the tracers refuse is not certified", "[
   from_file.tree_path = path;
   CHECK_THROWS(make_tracer("bsp", soup, from_file));  // what `bsprt trace --tree` runs
 }
+
+// Found by a differential review (2026-12-07): a finite scene near 3e38
+// failed in the BSP's flattening with "plane bound is not finite (scene
+// coordinates too large?)", while kd, bvh8 and the exact modes traced it. The
+// limit is real (float planes); the message now says what to use instead.
+TEST_CASE("bsp: a scene near the float range's end is refused with a message that names the accelerators that take it",
+          "[regression]") {
+  TriangleSoup s = load_mesh(bsprt::test::scene_path("cube.obj"));
+  for (Vec3f& v : s.vertices) v = v * 2e37f + Vec3f{3e38f, 3e38f, 3e38f};
+  classify_degenerate(s);
+  CHECK_THROWS_WITH(make_tracer("bsp", s, AccelOptions{}), Catch::Contains("trace it with kd, bvh8 or brute-certified"));
+  const ExactTracer exact(s);
+  const Ray r = ray_of({0, 0, 0}, {1, 1, 1});
+  REQUIRE(exact.trace(r).hit());
+  for (const char* name : {"kd", "bvh8", "brute-certified"}) {
+    CAPTURE(name);
+    const Hit h = make_tracer(name, s, AccelOptions{})->trace(r);
+    CHECK(h.prim == exact.trace(r).prim);
+    CHECK(h.t == exact.trace(r).t);
+  }
+}

@@ -68,7 +68,9 @@ NodePlan plan_node(const TriangleSoup& soup, PlaneDef def, const Cell& cell) {
   plan.kind = FlatBspNodeKind::Plane;
   plan.plane = float_plane_bound(g, pp, boxes);
   if (!std::isfinite(plan.plane.eps) || !std::isfinite(plan.plane.d))
-    throw UsageError("flatten_bsp: plane bound is not finite (scene coordinates too large?)");
+    throw UsageError("the BSP's float planes overflow for this scene: a split plane's offset or error bound is not "
+                     "finite with coordinates this close to the float range's end (about 1e38 and above); trace it "
+                     "with kd, bvh8 or brute-certified, which take any finite scene (docs/certified-epsilons.md)");
   return plan;
 }
 
