@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -67,10 +68,22 @@ Points read_points(const std::string& path) {
     bool rounded = false;
     for (int k = 0; k < 3; ++k) {
       double v = 0.0;
-      const auto [ptr, ec] = std::from_chars(word[k].data(), word[k].data() + word[k].size(), v);
-      if (ec == std::errc::result_out_of_range || (ec == std::errc{} && std::isfinite(v) && !std::isfinite(float(v))))
+      // A leading '+' as mesh files allow it (from_chars does not).
+      const char* first = word[k].data() + (word[k].size() > 1 && word[k][0] == '+' && word[k][1] != '-' ? 1 : 0);
+      const char* last = word[k].data() + word[k].size();
+      auto [ptr, ec] = std::from_chars(first, last, v);
+      if (ec == std::errc::result_out_of_range && ptr == last) {
+        // Out of double's range: beyond it is an overflow; below it (1e-400)
+        // the nearest float is 0 or a subnormal, a rounding like any other.
+        const double d = std::strtod(std::string(first, last).c_str(), nullptr);
+        if (std::isinf(d))
+          throw InputError(path, std::int64_t(n), "\"" + printable(word[k]) + "\" overflows float (points are float)");
+        v = d, ec = std::errc{};
+        rounded = true;  // the file's value is not 0, nor this subnormal
+      }
+      if (ec == std::errc{} && std::isfinite(v) && !std::isfinite(float(v)))
         throw InputError(path, std::int64_t(n), "\"" + printable(word[k]) + "\" overflows float (points are float)");
-      if (ec != std::errc{} || ptr != word[k].data() + word[k].size())
+      if (ec != std::errc{} || ptr != last)
         throw InputError(path, std::int64_t(n), "\"" + printable(word[k]) + "\" is not a number");
       if (!std::isfinite(v)) throw InputError(path, std::int64_t(n), "\"" + printable(word[k]) + "\" is not finite");
       p[k] = float(v);

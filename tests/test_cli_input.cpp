@@ -218,23 +218,28 @@ TEST_CASE("cli: inside reads points as the nearest floats, counts them, and name
   const std::string cube = scene_path("cube.obj"), out = temp_path("cli_in_inside.txt");
   const std::string points = temp_path("cli_in_inside_points.txt");
   // 0.50000001 and 0.49999999 round to 0.5, the cube's face: surface, and said to be rounded.
+  // 1e-400 is below double's range: 0, rounded (it was "overflows float"); a
+  // leading '+' reads as in mesh files (it was "not a number"). Review of 2026-12-07.
   std::ofstream(points) << "0.50000001 0 0\n0.49999999 0 0  # a comment after a point\n# a whole-line comment\n\n"
-                           "0 0 0\n";
+                           "0 0 0\n1e-400 +0.25 -1e-400\n";
   const Run r = bsprt_cli("inside " + cube + " " + points + " -o " + out);
   INFO(r.output);
   REQUIRE(r.status == 0);
-  CHECK(has(r, "3 points (2 with a coordinate rounded to the nearest float, as mesh coordinates are)"));
+  CHECK(has(r, "4 points (3 with a coordinate rounded to the nearest float, as mesh coordinates are)"));
   std::ifstream in(out);
-  std::string a, b, c;
-  in >> a >> b >> c;
+  std::string a, b, c, d;
+  in >> a >> b >> c >> d;
   CHECK(a == "surface");
   CHECK(b == "surface");
   CHECK(c == "inside");
+  CHECK(d == "inside");
   struct Case {
     std::string text, message;
   };
   for (const Case& k : {Case{"0 0 0\n1e39 0 0\n", ":2: \"1e39\" overflows float"},
                         Case{"nan 0 0\n", ":1: \"nan\" is not finite"},
+                        Case{"0 1e400 0\n", ":1: \"1e400\" overflows float"},
+                        Case{"0 ++1 0\n", ":1: \"++1\" is not a number"},
                         Case{std::string("0 0 \0 0\n", 8), ":1: expected three numbers \"x y z\", got \"0 0 ? 0\""},
                         Case{"1 2\n", ":1: expected three numbers"}}) {
     std::ofstream(points, std::ios::binary | std::ios::trunc) << k.text;
