@@ -679,3 +679,24 @@ TEST_CASE("STL: corners closer than FLT_MIN stay apart, as in the other formats"
   CHECK(!s.is_degenerate(1));
   CHECK(s.degenerate_count() == 0);
 }
+
+TEST_CASE("STL and OFF: a blank line in a loop, a binary 'solid' header and face colors on some faces", "[load][regression]") {
+  // A blank line inside `outer loop` is legal ascii STL; OpenMesh took it for a vertex.
+  const TriangleSoup a = load_mesh(write_file(
+      "blank.stl", "solid s\nfacet normal 0 0 1\nouter loop\n\nvertex 0 0 0\nvertex 1 0 0\n\nvertex 0 1 0\nendloop\n"
+                   "endfacet\nendsolid s\n"));
+  REQUIRE(a.size() == 1);
+  check_triangle(a, 0, P0, P1, P3);
+  // A binary file whose header starts with "solid" and whose count lies gets the binary message.
+  std::string b = binary_stl({{P0, P1, P3}, {P0, P3, P4}});
+  b.replace(0, 5, "solid");
+  b[80] = 3;
+  require_error(write_file("solid_header.stl", b), "binary STL: header declares 3 triangles");
+  // OFF face colors are optional per face, with or without a C header.
+  for (const std::string head : {"COFF\n4 2 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n0 1 0 1 0 0 1\n0 0 1 1 0 0 1\n",
+                                 "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"}) {
+    const TriangleSoup o = load_mesh(write_file("part_colors.off", head + "3 0 1 2 1 0 0\n3 0 2 3\n"));
+    INFO(head);
+    REQUIRE(o.size() == 2);
+  }
+}

@@ -269,6 +269,21 @@ Polygons load_stl(const std::string& path, std::string& bytes, const LoadOptions
                                          std::to_string(n.value) + "); allow_nonfinite keeps such triangles as never-hit degenerates");
     return stl_from_scan(scan);
   }
+  if (!scan.binary) {
+    // OpenMesh reads the lines after `outer loop` as the three vertices, so a
+    // blank line there (legal) failed the load (review of 2026-12-07). The
+    // pre-scan has run and kept its line numbers: hand OpenMesh the text
+    // without blank lines.
+    std::string compact;
+    compact.reserve(bytes.size());
+    for (std::size_t at = 0; at < bytes.size();) {
+      const std::size_t end = std::min(bytes.find('\n', at), bytes.size());
+      const std::string_view line(bytes.data() + at, end - at);
+      if (line.find_first_not_of(" \t\r\v\f") != std::string_view::npos) compact.append(line).push_back('\n');
+      at = end + 1;
+    }
+    bytes = std::move(compact);
+  }
   OpenMeshResult om = detail::openmesh_read(path, bytes, "stl", scan.binary);
   // OpenMesh's read is the cross-check of the pre-pass (every facet it keeps
   // must be the file's). The corners themselves come from the pre-pass:

@@ -296,10 +296,12 @@ void scan_off_face(const std::string& path, std::string& bytes, std::string_view
     scan.index_sum += static_cast<std::uint64_t>(index);
   }
   scan.corners += static_cast<std::size_t>(k);
-  // Without a 'C' header OpenMesh would read trailing values (colors) as the
-  // next face's vertex count; we do not use colors, so blank them.
-  if (!colors)
-    for (std::string_view tok = next_token(line, i); !tok.empty(); tok = next_token(line, i)) blank_out(bytes, tok, ' ');
+  // OpenMesh would read trailing values (a face color) as the next face's
+  // vertex count, or, with a 'C' header, misread a face that has none (face
+  // colors are optional per face: a COFF whose faces carry colors only in
+  // part failed; review of 2026-12-07). Colors are not used: blank them.
+  (void)colors;
+  for (std::string_view tok = next_token(line, i); !tok.empty(); tok = next_token(line, i)) blank_out(bytes, tok, ' ');
 }
 
 void scan_off_counts(const std::string& path, std::string_view line, std::int64_t line_no, ElementScan& scan) {
@@ -446,7 +448,11 @@ StlScan scan_stl(const std::string& path, std::string& bytes) {
     return scan;
   }
   std::size_t i = 0;
-  if (!iequals(next_token(bytes, i), "solid")) {
+  // Binary files may begin with "solid" too; a NUL byte (never in an ascii
+  // STL) says which this is, so that a wrong count gets the binary message,
+  // not "ascii STL ends inside a solid" (review of 2026-12-07).
+  const bool has_nul = bytes.find('\0') != std::string::npos;
+  if (!iequals(next_token(bytes, i), "solid") || (has_nul && bytes.size() >= 84)) {
     if (bytes.size() < 84) throw InputError(path, "binary STL shorter than its 84-byte header");
     throw InputError(path, "binary STL: header declares " + std::to_string(n) + " triangles (" +
                                std::to_string(84 + 50 * std::uint64_t{n}) + " bytes) but the file has " +
