@@ -22,8 +22,7 @@ namespace bsprt {
 
 struct Tree::Impl {
   Scene scene;
-  std::vector<std::byte> bytes;
-  std::shared_ptr<const TreeFileReader> reader;
+  std::shared_ptr<const TreeFileReader> reader;  ///< holds the file image, once; its sections are views
   double build_seconds = 0.0;
 };
 
@@ -84,25 +83,25 @@ Tree build(const Scene& scene, const BuildOptions& options) {
                      std::to_string(int(options.membership)));
   const auto t0 = Clock::now();
   const BuildMonitor monitor{options};
-  auto impl = std::make_shared<Tree::Impl>(Tree::Impl{scene, {}, nullptr, 0.0});
-  impl->bytes = options.kind == TreeKind::Kd ? build_kd_bytes(scene.soup(), options, monitor)
-                                             : build_bsp_bytes(scene.soup(), options, monitor);
-  impl->reader = std::make_shared<const TreeFileReader>("(built in memory)", impl->bytes);
+  auto impl = std::make_shared<Tree::Impl>(Tree::Impl{scene, nullptr, 0.0});
+  auto bytes = std::make_shared<const std::vector<std::byte>>(
+      options.kind == TreeKind::Kd ? build_kd_bytes(scene.soup(), options, monitor)
+                                   : build_bsp_bytes(scene.soup(), options, monitor));
+  impl->reader = std::make_shared<const TreeFileReader>("(built in memory)", std::move(bytes));
   impl->build_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return Tree(std::move(impl));
 }
 
 Tree Tree::load(const std::string& path, const Scene& scene) {
-  auto impl = std::make_shared<Impl>(Impl{scene, read_tree_file_image(path), nullptr, 0.0});
-  impl->reader = std::make_shared<const TreeFileReader>(path, impl->bytes);
+  auto impl = std::make_shared<Impl>(Impl{scene, std::make_shared<const TreeFileReader>(path), 0.0});
   impl->reader->check_scene(scene.soup());
   return Tree(std::move(impl));
 }
 
-void Tree::save(const std::string& path) const { write_tree_file_image(path, impl().bytes); }
+void Tree::save(const std::string& path) const { write_tree_file_image(path, impl().reader->image()); }
 
 TreeKind Tree::kind() const { return impl().reader->kind(); }
-std::span<const std::byte> Tree::bytes() const { return impl().bytes; }
+std::span<const std::byte> Tree::bytes() const { return impl().reader->image(); }
 double Tree::build_seconds() const { return impl().build_seconds; }
 const Scene& Tree::scene() const { return impl().scene; }
 std::shared_ptr<const TreeFileReader> Tree::file() const { return impl().reader; }

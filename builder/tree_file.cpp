@@ -123,9 +123,15 @@ void write_tree_file_image(const std::string& path, std::span<const std::byte> o
   if (!f) throw InputError(path, "cannot write tree file");
 }
 
-TreeFileReader::TreeFileReader(const std::string& path) : TreeFileReader(path, read_tree_file_image(path)) {}
+TreeFileReader::TreeFileReader(const std::string& path)
+    : TreeFileReader(path, std::make_shared<const std::vector<std::byte>>(read_tree_file_image(path))) {}
 
-TreeFileReader::TreeFileReader(const std::string& path, const std::vector<std::byte>& in) : path_(path) {
+TreeFileReader::TreeFileReader(const std::string& path, const std::vector<std::byte>& image)
+    : TreeFileReader(path, std::make_shared<const std::vector<std::byte>>(image)) {}
+
+TreeFileReader::TreeFileReader(const std::string& path, std::shared_ptr<const std::vector<std::byte>> image)
+    : path_(path), image_(std::move(image)) {
+  const std::vector<std::byte>& in = *image_;
   if (in.size() < kHeaderSize)
     throw InputError(path, "truncated tree file: " + std::to_string(in.size()) + " bytes, header needs 40");
   if (std::memcmp(in.data(), kMagic, 8) != 0) throw InputError(path, "not a bsprt tree file (bad magic)");
@@ -154,7 +160,7 @@ TreeFileReader::TreeFileReader(const std::string& path, const std::vector<std::b
       throw InputError(path, "truncated tree file: section " + tree_tag_name(tag) + " needs " +
                                  std::to_string(size) + " bytes");
     if (sections_.count(tag)) throw InputError(path, "section " + tree_tag_name(tag) + " appears twice");
-    sections_[tag].assign(in.begin() + std::ptrdiff_t(at), in.begin() + std::ptrdiff_t(at + size));
+    sections_[tag] = std::span<const std::byte>(in.data() + at, static_cast<std::size_t>(size));
     at += padded(size);
   }
   if (at != in.size())

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <span>
 #include <string>
 #include <type_traits>
@@ -80,8 +81,13 @@ class TreeFileReader {
  public:
   explicit TreeFileReader(const std::string& path);
   /// Checks a file image held in memory (TreeFileWriter::bytes); `path` names
-  /// it in messages.
+  /// it in messages. The image is copied once; sections are views into it.
   TreeFileReader(const std::string& path, const std::vector<std::byte>& image);
+  /// The same, sharing the image instead of copying it (bsprt::Tree keeps
+  /// its file once in memory, not once as bytes and again as sections).
+  TreeFileReader(const std::string& path, std::shared_ptr<const std::vector<std::byte>> image);
+  /// The whole file image the sections point into.
+  std::span<const std::byte> image() const { return *image_; }
   TreeKind kind() const { return kind_; }
   /// The file's format version (1: its header is not covered by the CRC).
   std::uint32_t version() const { return version_; }
@@ -109,7 +115,8 @@ class TreeFileReader {
   TreeKind kind_{};
   std::uint64_t fingerprint_ = 0;
   std::uint64_t triangle_count_ = 0;
-  std::map<std::uint32_t, std::vector<std::byte>> sections_;
+  std::shared_ptr<const std::vector<std::byte>> image_;
+  std::map<std::uint32_t, std::span<const std::byte>> sections_;  ///< views into *image_
 };
 
 template <typename T>

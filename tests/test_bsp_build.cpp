@@ -406,6 +406,15 @@ TEST_CASE("bsp: tree file round trip and rejection", "[bsp][file]") {
   CHECK(check_leaves(s, u) == "");
   const TriangleSoup other = uv_sphere(5, 12);
   CHECK_THROWS_AS(read_bsp_file(path, other), InputError);
+  // The reader holds the file once: its sections are views into the image it
+  // shares (bsprt::Tree kept the file as bytes and again as section copies).
+  const auto image = std::make_shared<const std::vector<std::byte>>(read_tree_file_image(path));
+  const TreeFileReader r(path, image);
+  CHECK(r.image().data() == image->data());
+  const std::span<const std::byte> nodes = r.section(kBspNodesTag);
+  CHECK(nodes.data() >= image->data());
+  CHECK(nodes.data() + nodes.size() <= image->data() + image->size());
+  CHECK(read_bsp_sections(r, s).nodes().size() == t.nodes().size());
 }
 
 TEST_CASE("bsp: progress reaches the total, report adds up", "[bsp]") {
