@@ -20,6 +20,7 @@
 #include "geometry/scenes/stiff_rays.h"
 #include "geometry/scenes/stiff_scenes.h"
 #include "stiff_util.h"
+#include "test_util.h"
 
 using namespace bsprt;
 using namespace bsprt::test;
@@ -108,7 +109,9 @@ TEST_CASE("stiff: tiny_1e-6", "[stiff]") { check_scene("tiny_1e-6"); }
 TEST_CASE("stiff: huge_1e6", "[stiff]") { check_scene("huge_1e6"); }
 
 TEST_CASE("stiff: bsprt gen writes a scene that loads back bit for bit", "[stiff][cli]") {
-  const std::string obj = "stiff_gen_test_degenerate.obj", rays = "stiff_gen_test.rays";
+  // In the tests' temporary folder, not the working directory (a run from the
+  // source tree left these files there).
+  const std::string obj = temp_path("stiff_gen_test_degenerate.obj"), rays = temp_path("stiff_gen_test.rays");
   const std::string cmd = std::string(BSPRT_CLI_PATH) + " gen degenerate -o " + obj + " --rays axis-plane -n 50 --rays-out " +
                           rays + " > /dev/null";
   REQUIRE(std::system(cmd.c_str()) == 0);
@@ -118,5 +121,40 @@ TEST_CASE("stiff: bsprt gen writes a scene that loads back bit for bit", "[stiff
   CHECK(back.triangles == sc.soup.triangles);
   CHECK(back.degenerate == sc.soup.degenerate);
   CHECK(read_rays(rays).size() == 50);
-  CHECK(std::system((std::string(BSPRT_CLI_PATH) + " gen nope -o x.obj 2> /dev/null").c_str()) != 0);
+  CHECK(std::system((std::string(BSPRT_CLI_PATH) + " gen nope -o " + temp_path("x.obj") + " 2> /dev/null").c_str()) != 0);
+}
+
+// Found by a review of the ray generators (2026-12-07): grazing rays on needle
+// triangles had a NaN normal (cross product 0 in float), so 73 of 300 on
+// `degenerate` were invalid rays counted as checked; axis-parallel rays "through
+// an edge point" went through a rounded point an ulp off slanted edges.
+TEST_CASE("stiff rays: grazing rays are valid, axis-parallel rays pass exactly through a vertex or an edge point",
+          "[stiff][regression]") {
+  for (const char* name : {"degenerate", "slivers", "grid_box", "far_1e7"}) {
+    CAPTURE(name);
+    const StiffScene sc = make_stiff_scene(name);
+    for (const Ray& r : stiff_rays(StiffRayKind::Grazing, sc.soup, 300, 7)) CHECK(is_valid(r));
+    std::size_t edge_points = 0;
+    for (const Ray& r : stiff_rays(StiffRayKind::AxisParallel, sc.soup, 300, 7)) {
+      int axis = -1;
+      for (int k = 0; k < 3; ++k)
+        if (r.dir[k] != 0) axis = k;
+      REQUIRE(axis >= 0);
+      const auto across = [&](const Vec3d& p) {  // the ray's line holds p exactly
+        for (int i = 0; i < 3; ++i)
+          if (i != axis && double(r.org[i]) != p[i]) return false;
+        return true;
+      };
+      bool through = false, at_midpoint = false;
+      for (std::uint32_t t = 0; t < sc.soup.size() && !through; ++t)
+        for (int k = 0; k < 3 && !through; ++k) {
+          const Vec3d a(sc.soup.corner(t, k)), b(sc.soup.corner(t, (k + 1) % 3));
+          through = across(a);
+          if (!through && across((a + b) * 0.5)) through = at_midpoint = true;
+        }
+      CHECK(through);
+      edge_points += at_midpoint;
+    }
+    CHECK(edge_points > 0);
+  }
 }
