@@ -103,6 +103,10 @@ struct BenchResult {
 };
 
 /// Runs the benchmark. Throws UsageError for unknown modes or ray sets.
+/// Throws UsageError for a mode or ray set that is unknown or listed twice,
+/// or counts out of range; run_bench calls it first, `bsprt bench` before it
+/// loads a scene or makes the output directory.
+void check_bench_options(const BenchOptions& options);
 BenchResult run_bench(const std::vector<BenchScene>& scenes, const BenchOptions& options);
 
 /// Traces all rays with `width`-wide packets over blocks of 1024 on all

@@ -71,9 +71,10 @@ std::filesystem::path output_dir(const BenchArgs& a) {
 }
 
 void run(const BenchArgs& a) {
-  for (std::size_t i = 0; i < a.modes.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (a.modes[i] == a.modes[j]) throw UsageError("--modes lists " + a.modes[i] + " twice");
+  BenchOptions o;
+  o.ray_sets = a.rays, o.modes = a.modes, o.count = a.count, o.error_count = a.error_count;
+  o.threads = a.threads, o.runs = a.runs, o.seed = a.seed;
+  check_bench_options(o);  // before any scene is loaded or -o is made
   const std::filesystem::path dir = output_dir(a);
   const auto cap = limit_threads(a.threads);
   std::vector<BenchScene> scenes;
@@ -81,9 +82,6 @@ void run(const BenchArgs& a) {
     scenes.push_back(load_bench_scene(s));
     fmt::print(stderr, "bench: scene {} ({} triangles)\n", scenes.back().name, scenes.back().soup.size());
   }
-  BenchOptions o;
-  o.ray_sets = a.rays, o.modes = a.modes, o.count = a.count, o.error_count = a.error_count;
-  o.threads = a.threads, o.runs = a.runs, o.seed = a.seed;
   if (!a.cameras.empty()) o.cameras = read_camera_file(a.cameras);
   std::unique_ptr<ProgressBar> bar;
   o.progress = [&](const std::string&, std::size_t done, std::size_t total) {

@@ -17,3 +17,13 @@ cmake -S "$src/examples/consumer" -B "$tmp/consumer" -G Ninja -DCMAKE_BUILD_TYPE
 cmake --build "$tmp/consumer" > "$tmp/build.log"
 "$tmp/consumer/consumer" "$mesh"
 "$tmp/prefix/bin/bsprt" info "$mesh" > /dev/null
+# The installed Python module must load the installed libbsprt from this
+# prefix, not one in /usr/local (its RPATH was fixed there; review of 2026-12-07).
+pydir=$(find "$tmp/prefix" -type d -name dist-packages | head -1)
+if [ -n "$pydir" ] && [ -d "$pydir/bsprt" ]; then
+  env -u LD_LIBRARY_PATH PYTHONPATH="$pydir" /usr/bin/python3 -c "
+import bsprt, os, sys
+lib = [l.split()[-1] for l in open('/proc/self/maps') if 'libbsprt.so' in l]
+assert lib and all(p.startswith(sys.argv[1]) for p in lib), lib
+" "$tmp/prefix"
+fi
