@@ -1,5 +1,7 @@
 #include "apps/cli_common.h"
 
+#include <filesystem>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -67,6 +69,22 @@ CLI::Validator integer_in(long long lo, long long hi) {
 CLI::Validator non_empty_path() {
   return CLI::Validator([](std::string& s) -> std::string { return s.empty() ? "must not be an empty path" : ""; },
                         "PATH");
+}
+
+CLI::Validator output_file() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        if (s.empty()) return "must not be an empty path";
+        std::error_code ec;
+        const std::filesystem::path p(s);
+        if (std::filesystem::is_directory(p, ec) || s.back() == '/')
+          return "'" + s + "' is a directory; give a file to write";
+        const std::filesystem::path parent = p.parent_path();
+        if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+          return "the folder '" + parent.string() + "' of '" + s + "' does not exist";
+        return "";
+      },
+      "FILE");
 }
 
 void reject_given(const CLI::App& cmd, const std::vector<std::string>& names, const std::string& why) {
@@ -152,11 +170,11 @@ std::unique_ptr<tbb::global_control> limit_threads(int threads) {
 namespace {
 /// Which of the accelerator-specific options `o.accel` uses.
 struct UsedOptions {
-  bool single_rays, top_slots, membership;
+  bool single_rays, top_slots, membership, packets;
 };
 UsedOptions used_options(const TraceOptions& o) {
   const AccelInfo& a = accel_info(o.accel);
-  return {a.uses_single_rays, a.uses_top_slots, a.tree == AccelTree::Bsp && o.tree.empty()};
+  return {a.uses_single_rays, a.uses_top_slots, a.tree == AccelTree::Bsp && o.tree.empty(), a.packets};
 }
 }  // namespace
 
@@ -168,6 +186,10 @@ std::vector<std::string> ignored_options(const TraceOptions& o) {
     ignored.push_back("--single-rays (bsp, bsp-float, bsp-zero-eps only)");
   if (o.top_slots != defaults.top_slots && !used.top_slots)
     ignored.push_back("--top-slots (bsp-top, bsp-top-float, bsp-bvh8, bsp-bvh8-float only)");
+  // An accelerator without packets traces a batch ray by ray: --packets 16
+  // was accepted and reported in --json as if packets had run (review of 2026-12-07).
+  if (o.packets != defaults.packets && o.packets > 1 && !used.packets)
+    ignored.push_back("--packets (" + o.accel + " traces single rays only)");
   if (o.membership != defaults.membership && !used.membership)
     ignored.push_back(o.tree.empty() ? "--membership (BSP accelerators only)"
                                      : "--membership (a BSP built in memory only; the tree file fixed it when it was "
@@ -181,6 +203,7 @@ TraceOptions without_ignored_options(TraceOptions o) {
   if (!used.single_rays) o.single_rays = defaults.single_rays;
   if (!used.top_slots) o.top_slots = defaults.top_slots;
   if (!used.membership) o.membership = defaults.membership;
+  if (!used.packets) o.packets = 1;
   return o;
 }
 

@@ -40,6 +40,10 @@ CLI::Validator number_in_open(double lo, double hi);
 CLI::Validator integer_in(long long lo, long long hi);
 /// A path option given as an empty string (it would mean "not given").
 CLI::Validator non_empty_path();
+/// A file to write: not empty, not a directory, in a folder that exists,
+/// checked when the command line is parsed, before any work (an -o naming a
+/// directory failed only after the build and the trace; review of 2026-12-07).
+CLI::Validator output_file();
 
 /// Largest ray count `gen-rays -n` writes (32 GB of rays), and largest image
 /// side of --size: past these a run fails for memory, not for a reason a

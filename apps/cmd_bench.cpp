@@ -122,9 +122,11 @@ void register_bench(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--modes", args->modes, "accelerators (see --accel of trace)")->delimiter(',')->capture_default_str();
-  cmd->add_option("--count", args->count, "rays per set for speed and counters")
+  cmd->add_option("--count", args->count, "rays per set for speed")
       ->capture_default_str()->check(integer_in(1, kMaxRays));
-  cmd->add_option("--error-count", args->error_count, "rays per set checked against the exact reference (0 = none)")
+  cmd->add_option("--error-count", args->error_count,
+                  "rays per set (every k-th of the --count rays) checked against the exact reference and counted for "
+                  "node visits and triangle tests (0 = no check, counters on all --count rays)")
       ->capture_default_str()->check(integer_in(0, kMaxRays));
   cmd->add_option("--threads", args->threads, "worker threads for every mode (0 = all cores)")
       ->check(integer_in(0, kMaxThreads))->capture_default_str();

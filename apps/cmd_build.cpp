@@ -23,7 +23,7 @@ namespace bsprt::cli {
 namespace {
 
 struct BuildArgs {
-  std::string scene, output, accel = "kd", membership = "area";
+  std::string scene, output, accel = "bsp", membership = "area";  // bsp: the default everywhere (trace, render, the API)
   int threads = 0;
   bool allow_nonfinite = false;
   bool paper = false;  // the paper's full BSP: face/edge candidates at every node size
@@ -179,7 +179,7 @@ void register_build(CLI::App& app) {
   auto args = std::make_shared<BuildArgs>();
   CLI::App* cmd = app.add_subcommand("build", "build a tree and write it to a tree file bound to the scene");
   cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
-  cmd->add_option("-o,--output", args->output, "tree file to write")->required();
+  cmd->add_option("-o,--output", args->output, "tree file to write")->required()->check(output_file());
   cmd->add_option("--accel", args->accel, "kd (SAH kd-tree) or bsp (exact general BSP)")->capture_default_str();
   cmd->add_option("--membership", args->membership, "bsp: area (default) or closed, see docs/bsp-build.md")
       ->capture_default_str();

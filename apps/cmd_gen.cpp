@@ -67,20 +67,23 @@ void register_gen(CLI::App& app) {
   auto args = std::make_shared<GenArgs>();
   CLI::App* cmd = app.add_subcommand("gen", "write a stiff test scene (OBJ) and/or one of its stiff ray sets");
   cmd->add_option("SCENE", args->scene, "stiff scene name (--list shows them)");
-  cmd->add_option("-o,--output", args->output, "OBJ file to write");
+  cmd->add_option("-o,--output", args->output, "OBJ file to write")->check(output_file());
   cmd->add_option("--detail", args->detail, "tessellation level of the solids, 0..4")->capture_default_str();
   cmd->add_option("--rays", args->rays,
                   "with --rays-out: vertex | edge | along-edge | grazing | axis-plane | axis-parallel | invalid | inside")
       ->default_val("vertex")
       ->check(CLI::IsMember({"vertex", "edge", "along-edge", "grazing", "axis-plane", "axis-parallel", "invalid",
                              "inside"}));
-  cmd->add_option("--rays-out", args->rays_output, ".rays file to write");
+  cmd->add_option("--rays-out", args->rays_output, ".rays file to write")->check(output_file());
   cmd->add_option("-n,--count", args->count, "number of rays")->capture_default_str()->check(integer_in(1, kMaxRays));
   cmd->add_option("--seed", args->seed, "random seed")->capture_default_str();
   cmd->add_flag("--list", args->list, "list the stiff scenes");
   cmd->callback([args, cmd] {
     // Ray options without a .rays file to write would be ignored.
     if (args->rays_output.empty()) reject_given(*cmd, {"--rays", "--count", "--seed"}, "ray options need --rays-out");
+    // These scenes are fixed lists of triangles: a detail level would be ignored.
+    if (args->scene == "slivers" || args->scene == "degenerate" || args->scene == "stacks")
+      reject_given(*cmd, {"--detail"}, "scene '" + args->scene + "' has no tessellation level");
     run(*args);
   });
 }

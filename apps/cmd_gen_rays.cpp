@@ -33,7 +33,9 @@ void run(const GenRaysArgs& a) {
     throw UsageError("-n and --size both set the number of primary rays: give one");
   const TriangleSoup soup = load_scene(a.scene, a.allow_nonfinite, true);
   std::vector<Ray> rays;
-  if (kind == RaySetKind::Primary && (!a.size.empty() || !a.camera.empty())) {
+  // Every primary set takes its camera here, -n too: through make_rays the
+  // default scene was framed instead of seen from its own view (review of 2026-12-07).
+  if (kind == RaySetKind::Primary) {
     const bool is_default = a.scene.empty() || a.scene == "default";
     const Camera cam = !a.camera.empty() ? camera_from_spec(a.camera).camera
                        : is_default      ? default_scene_camera()
@@ -53,7 +55,7 @@ void register_gen_rays(CLI::App& app) {
   auto args = std::make_shared<GenRaysArgs>();
   CLI::App* cmd = app.add_subcommand("gen-rays", "write a .rays file: primary, random, vertex- or edge-aimed rays");
   cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
-  cmd->add_option("-o,--output", args->output, ".rays file to write")->required();
+  cmd->add_option("-o,--output", args->output, ".rays file to write")->required()->check(output_file());
   cmd->add_option("--kind", args->kind, "primary | random | vertex | edge")->capture_default_str();
   cmd->add_option("-n,--count", args->count, "number of rays (primary: about n pixels, square)")
       ->capture_default_str()->check(integer_in(1, kMaxRays));
@@ -65,6 +67,8 @@ void register_gen_rays(CLI::App& app) {
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
   cmd->callback([args, cmd] {
     args->count_given = cmd->count("--count") > 0;
+    // Primary rays come from the camera alone: a seed would be ignored.
+    if (args->kind == "primary") reject_given(*cmd, {"--seed"}, "primary rays are not random");
     run(*args);
   });
 }

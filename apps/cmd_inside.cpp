@@ -145,7 +145,7 @@ void register_inside(CLI::App& app) {
   cmd->add_option("POINTS", args->points,
                   "text file: one point \"x y z\" per line ('#' comments), each coordinate read as the nearest float")
       ->required();
-  cmd->add_option("-o,--output", args->output, "text file: inside, outside or surface, a line per point")->required();
+  cmd->add_option("-o,--output", args->output, "text file: inside, outside or surface, a line per point")->required()->check(output_file());
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
   cmd->callback([args] { run(*args); });
 }

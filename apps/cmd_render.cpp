@@ -169,6 +169,12 @@ void run_heat(const RenderArgs& a, const Accelerator& tracer, const TriangleSoup
 
 void run(const RenderArgs& a) {
   check_output(a.output);
+  if (a.mode == "heat" && parse_heat_metric(a.heat_metric) != HeatMetric::Time)
+    for (const std::string& accel : {a.trace.accel, a.heat_compare})
+      if (!accel.empty() && accel_info(accel).embree_domain)
+        // Embree reports no counts: the map was all zeros, with exit 0 (review of 2026-12-07).
+        throw UsageError("--heat-metric " + a.heat_metric + ": " + accel +
+                         " does not count its node visits or triangle tests; use --heat-metric time");
   const auto threads = limit_threads(a.trace.threads);
   const TriangleSoup soup = load_scene(a.scene, a.trace.allow_nonfinite, true);
   RenderOptions options;
@@ -188,7 +194,7 @@ void register_render(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "render a scene: ray casting, path tracing or cost heat maps");
   cmd->add_option("SCENE", args->scene, std::string(kSceneHelp) + "; omit for the default scene");
-  cmd->add_option("-o,--output", args->output, "image to write (.png, or .pfm for raw radiance)")->capture_default_str();
+  cmd->add_option("-o,--output", args->output, "image to write (.png, or .pfm for raw radiance)")->capture_default_str()->check(output_file());
   cmd->add_option("--mode", args->mode, "cast (eye light, packets) | path (path tracing) | heat (cost per pixel)")
       ->capture_default_str()->check(CLI::IsMember({"cast", "path", "heat"}));
   cmd->add_option("--size", args->size, "image width and height")
@@ -208,7 +214,8 @@ void register_render(CLI::App& app) {
       ->check(CLI::Range(0, 64));
   cmd->add_option("--seed", args->seed, "path: random seed (images are identical for any thread count)")
       ->capture_default_str();
-  cmd->add_option("--json", args->json, "path: write a JSON summary (rays, Mrays/s by bounce) to this file");
+  cmd->add_option("--json", args->json, "path: write a JSON summary (rays, Mrays/s by bounce) to this file")
+      ->check(output_file());
   cmd->add_option("--heat-metric", args->heat_metric, "heat: time | nodes | tests")->capture_default_str();
   cmd->add_option("--heat-compare", args->heat_compare, "heat: draw the difference to this accelerator's map");
   cmd->add_option("--heat-max", args->heat_max, "heat: top of the colour scale (0 = the image's maximum)")
@@ -219,6 +226,10 @@ void register_render(CLI::App& app) {
     if (args->mode != "path") reject_given(*cmd, {"--spp", "--bounces", "--seed", "--json"}, "for --mode path only");
     if (args->mode != "heat")
       reject_given(*cmd, {"--heat-metric", "--heat-compare", "--heat-max"}, "for --mode heat only");
+    // A heat map traces single rays, one at a time, and counts its own work.
+    if (args->mode == "heat") reject_given(*cmd, {"--packets", "--single-rays", "--stats"}, "not used by --mode heat");
+    if (!args->heat_compare.empty())
+      reject_given(*cmd, {"--heat-max"}, "a difference map scales to its own largest difference");
     run(*args);
   });
 }

@@ -248,7 +248,7 @@ void register_trace(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("trace", "trace a .rays file and write the nearest hits to a .hits file");
   cmd->add_option("SCENE", args->scene, kSceneHelp)->required();
   cmd->add_option("RAYS", args->rays, ".rays file (see `bsprt gen-rays`)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", args->hits, ".hits file to write")->required();
+  cmd->add_option("-o,--output", args->hits, ".hits file to write")->required()->check(output_file());
   add_trace_options(*cmd, args->trace, "bsp");
   cmd->add_flag("--all-hits", args->all_hits,
                 "write every crossing of every ray, exactly (simulation of simplicity: a ray through a shared edge "

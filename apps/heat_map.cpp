@@ -120,7 +120,9 @@ std::vector<float> pixel_costs(const Accelerator& tracer, const RenderOptions& o
       } else {
         RayCounters rc;
         tracer.trace(ray, &rc);
-        c = metric == HeatMetric::Nodes ? float(rc.kd_node_visits + rc.bsp_node_visits) : float(rc.triangle_tests);
+        // Nodes: every kind of node a tracer counts, box nodes too (bvh8's map was blank).
+        c = metric == HeatMetric::Nodes ? float(rc.kd_node_visits + rc.bsp_node_visits + rc.box_node_visits)
+                                        : float(rc.triangle_tests);
       }
     }
   });

@@ -1,6 +1,8 @@
 #include "robust/inside_query.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <map>
 #include <utility>
 #include <vector>
@@ -12,13 +14,23 @@ std::string point_side_name(PointSide s) {
 }
 
 std::size_t open_or_inconsistent_edges(const TriangleSoup& soup) {
+  // Vertices by position, not number: a mesh whose triangles each have their
+  // own copies of the corners (an OBJ of `bsprt gen grid_box`) is closed too
+  // (it was reported as 576 open edges; review of 2026-12-07).
+  std::map<std::array<std::uint32_t, 3>, std::uint32_t> by_position;
+  std::vector<std::uint32_t> canonical(soup.vertices.size());
+  for (std::size_t v = 0; v < soup.vertices.size(); ++v) {
+    std::array<std::uint32_t, 3> key;
+    for (int k = 0; k < 3; ++k) key[k] = std::bit_cast<std::uint32_t>(soup.vertices[v][k] + 0.0f);  // -0 is +0
+    canonical[v] = by_position.emplace(key, std::uint32_t(by_position.size())).first->second;
+  }
   // Per undirected edge: uses in each direction (lower vertex first = forward).
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<int, int>> uses;
   for (std::uint32_t t = 0; t < soup.size(); ++t) {
     if (soup.is_degenerate(t)) continue;
     const auto& tri = soup.triangles[t];
     for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      const std::uint32_t a = canonical[tri[k]], b = canonical[tri[(k + 1) % 3]];
       auto& u = uses[{std::min(a, b), std::max(a, b)}];
       (a < b ? u.first : u.second) += 1;
     }

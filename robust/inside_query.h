@@ -21,7 +21,7 @@ enum class PointSide : std::uint8_t { Outside, Inside, OnSurface };
 /// "outside", "inside", "surface".
 std::string point_side_name(PointSide s);
 
-/// Edges of non-degenerate triangles (by vertex number) used by other than
+/// Edges of non-degenerate triangles (by vertex position) used by other than
 /// exactly two triangles, or twice in the same direction: 0 for a closed,
 /// consistently oriented 2-manifold, where parity is well defined.
 std::size_t open_or_inconsistent_edges(const TriangleSoup& soup);

@@ -148,11 +148,17 @@ TEST_CASE("cli: render refuses a camera that sees nothing and an unwritable --js
   const Run s = bsprt_cli("render --camera " + cams + png);
   CHECK(s.status == 1);
   CHECK(has(s, "\"fov\" must be a number"));
-  // --json that cannot be written was silently skipped (exit 0).
+  // --json that cannot be written was silently skipped (exit 0). A missing
+  // folder is now a usage error before any work; a folder that exists but
+  // cannot be written to still fails, after the render, with exit 1.
   const Run j = bsprt_cli("render --mode path --spp 1 --bounces 0 --json " + temp_path("no_such_dir/x.json") + png);
   INFO(j.output);
-  CHECK(j.status == 1);
-  CHECK(has(j, "cannot write the --json summary"));
+  CHECK(j.status == 2);
+  CHECK(has(j, "does not exist"));
+  const Run w = bsprt_cli("render --mode path --spp 1 --bounces 0 --json /proc/bsprt_x.json" + png);
+  INFO(w.output);
+  CHECK(w.status == 1);
+  CHECK(has(w, "cannot write the --json summary"));
 }
 
 TEST_CASE("cli: trace --all-hits refuses options it would ignore and prints JSON with --json", "[cli][regression]") {
@@ -293,4 +299,39 @@ TEST_CASE("cli: trace counts and reports invalid rays", "[cli][regression]") {
   CHECK(j.output.find("\"invalid_rays\": 4") != std::string::npos);
   const Run ok = bsprt_cli("trace default " + path + " -o " + hits + " --all-hits --json");
   CHECK(ok.output.find("\"invalid_rays\": 4") != std::string::npos);
+}
+
+// Found by reviews of the docs and of bench/render/gen (2026-12-07): outputs
+// naming a directory failed only after all the work, and options a command
+// would ignore were accepted (README: "refused rather than dropped").
+TEST_CASE("cli: output paths are checked before any work, and ignored options are refused", "[cli][regression]") {
+  const std::string dir = temp_path("cli_out_dir.hits"), rays = temp_path("cli_out.rays");
+  std::filesystem::create_directories(dir);
+  REQUIRE(bsprt_cli("gen-rays default -n 20 -o " + rays).status == 0);
+  struct Case {
+    std::string args, message;
+  };
+  for (const Case& c : {
+           Case{"trace default " + rays + " -o " + dir, "is a directory; give a file to write"},
+           Case{"build default -o " + dir, "is a directory; give a file to write"},
+           Case{"render default --size 8 8 -o " + temp_path("no_such_folder") + "/x.png", "does not exist"},
+           Case{"render default --size 8 8 --json " + dir + " -o " + temp_path("cli_out.png"), "is a directory"},
+           Case{"trace default " + rays + " -o " + temp_path("cli_out.hits") + " --accel bvh8 --packets 16",
+                "bvh8 traces single rays only"},
+           Case{"render default --mode heat --packets 8 --size 8 8 -o " + temp_path("cli_heat.png"),
+                "--packets: not used by --mode heat"},
+           Case{"render default --mode heat --heat-compare kd --heat-max 2 --size 8 8 -o " + temp_path("cli_heat.png"),
+                "--heat-max: a difference map"},
+           Case{"render default --mode heat --accel embree --heat-metric tests --size 8 8 -o " + temp_path("cli_heat.png"),
+                "embree does not count"},
+           Case{"gen-rays default --kind primary --seed 5 -o " + rays, "--seed: primary rays are not random"},
+           Case{"gen slivers --detail 2 -o " + temp_path("cli_slivers.obj"), "has no tessellation level"},
+           Case{"bench default --rays vertex,vertex --modes kd -o " + temp_path("cli_bench_dup"), "--rays lists vertex twice"},
+           Case{"bench default --rays vertex --modes bsp-certified -o " + temp_path("cli_bench_old"), "is now 'bsp'"}}) {
+    const Run r = bsprt_cli(c.args);
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.status == 2);
+    CHECK(has(r, c.message));
+  }
+  CHECK_FALSE(std::filesystem::exists(temp_path("cli_bench_old")));  // refused before -o was made
 }

@@ -62,7 +62,7 @@ def main():
     kd = scene.build(accel="kd")
     tracers = {"bsp (certified)": bsprt.Tracer(scene, bsp, "certified"),
                "bsp-float": bsprt.Tracer(scene, bsp, "float"),
-               "kd": bsprt.Tracer(scene, kd, "float"),
+               "kd-float": bsprt.Tracer(scene, kd, "float"),
                "embree": bsprt.Tracer(scene, accel="embree"),
                "embree-fast": bsprt.Tracer(scene, accel="embree-fast")}
     exact = bsprt.Tracer.exact(scene)

@@ -65,7 +65,7 @@ Ray CameraRays::ray(int x, int y, float sx, float sy) const {
 Camera frame_bounds(const Box3f& bounds, float fov) {
   if (!(bounds.lo.x <= bounds.hi.x && bounds.lo.y <= bounds.hi.y && bounds.lo.z <= bounds.hi.z))
     throw UsageError("the scene has no non-degenerate triangle, so there is nothing to frame: give a camera "
-                     "(--camera, or --vp and --vi)");
+                     "(render: --camera, or --vp and --vi; gen-rays: --camera; bench: --cameras)");
   Camera cam;
   const Vec3f c = bounds.center();
   const float radius = 0.5f * length(bounds.diagonal());
@@ -77,7 +77,7 @@ Camera frame_bounds(const Box3f& bounds, float fov) {
   cam.fov = fov;
   if (const std::string problem = camera_problem(cam); !problem.empty())
     throw UsageError("cannot frame the scene (its bounds are too large for a float camera: " + problem +
-                     "): give a camera (--camera, or --vp and --vi)");
+                     "): give a camera (render: --camera, or --vp and --vi; gen-rays: --camera; bench: --cameras)");
   return cam;
 }
 
