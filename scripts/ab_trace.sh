@@ -11,7 +11,8 @@
 #   scripts/ab_trace.sh SCENE RAYS TREE ROUNDS label:BIN:accel ...
 #   scripts/ab_trace.sh sponza.obj cam.rays sponza.bsp 5 old:/tmp/bsprt.old:bsp new:build/apps/bsprt:bsp
 # TREE is passed to bsp* accelerators; KD_TREE=file passes one to kd*.
-# EXTRA="--packets 16" adds options to every run. Not run in CI (timing).
+# EXTRA="--packets 16" adds options to every run (the CLI refuses --packets for single-ray-only
+# accelerators: bvh8, bsp-top, bsp-bvh8, exact). Not run in CI (timing).
 set -euo pipefail
 if [ $# -lt 5 ]; then
   sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//' >&2

@@ -20,6 +20,10 @@ cmake --build "$tmp/consumer" > "$tmp/build.log"
 # The installed Python module must load the installed libbsprt from this
 # prefix, not one in /usr/local (its RPATH was fixed there; review of 2026-12-07).
 pydir=$(find "$tmp/prefix" -type d -name dist-packages | head -1)
+if ls "$build"/python/bsprt/_bsprt*.so > /dev/null 2>&1 && { [ -z "$pydir" ] || [ ! -d "$pydir/bsprt" ]; }; then
+  echo "consumer_test: the build has the Python module but the install does not" >&2
+  exit 1
+fi
 if [ -n "$pydir" ] && [ -d "$pydir/bsprt" ]; then
   env -u LD_LIBRARY_PATH PYTHONPATH="$pydir" /usr/bin/python3 -c "
 import bsprt, os, sys

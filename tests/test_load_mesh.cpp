@@ -655,13 +655,22 @@ TEST_CASE("PLY binary: property types OpenMesh cannot convert are skipped or nam
   require_error(write_file("intcoords.ply", c), "binary PLY vertex coordinate 'x' of type int is not supported");
 }
 
-TEST_CASE("OBJ: a CR inside a line and extra values on a v line are errors, colors and 1-value vt load",
+TEST_CASE("OBJ: a CR joining statements and a word after v coordinates are errors, colors and 1-value vt load",
           "[load][regression]") {
   require_error(write_file("mixcr.obj", "v 0 0 0\nv 1 0 0\rv 9 9 9\nv 0 1 0\nf -3 -2 -1\n"),
                 ":2: carriage return inside a line");
   require_error(write_file("cr_only.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r"), ":1: carriage return inside a line");
-  require_error(write_file("vjoin.obj", "v 0 0 0 1 0 0 0 1 0\nf 1 1 1\n"), ":1: vertex 1 has 9 values");
   require_error(write_file("vword.obj", "v 0 0 0 v\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), ":1: vertex 1: 'v' after the coordinates");
+  require_error(write_file("cr_comment_joins.obj", "# c\rv 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r"),
+                ":1: carriage return inside a line");
+  // Valid files that must keep loading: CRs in a comment, CR CR LF line ends,
+  // and v lines with 5 or 8 values (exporters add weights and colours).
+  for (const char* text : {"# a comment\r with a CR\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                           "v 0 0 0\r\r\nv 1 0 0\r\r\nv 0 1 0\r\r\nf 1 2 3\r\r\n",
+                           "v 0 0 0 1 2\nv 1 0 0 1 2\nv 0 1 0 1 1 0 0 1\nf 1 2 3\n"}) {
+    INFO(text);
+    CHECK(load_mesh(write_file("cr_ok.obj", text)).size() == 1);
+  }
   const TriangleSoup s = load_mesh(write_file(
       "colors_vt.obj", "v 0 0 0 1 0 0\nv 1 0 0 0.5 0.5 0.5 1\nv 0 1 0 nan 0 0\nv 0 0 1 2\nvt 0.5\nvt nan 0\n"
                        "f 1/1 2/2 3/1\nf 1 3 4\n"));

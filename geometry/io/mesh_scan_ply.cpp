@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "bsprt/error.h"
 #include "geometry/io/mesh_scan.h"
@@ -293,12 +294,20 @@ void walk_binary(const std::string& path, const std::string& bytes, const PlyHea
       scan.coords.push_back(p);
     }
   }
-  // A newline (LF or CR LF) after the data is harmless; anything else means
-  // the header's counts are smaller than what the file holds. Not more: a
-  // record of whitespace bytes (a face 9 10 11 ... as uchar) is data, and
-  // skipping it lost the face without a word (review of 2026-12-07).
+  // Newlines after the data are harmless, but a record of whitespace bytes (a
+  // face 9 10 11 ... as uchar) is data, and skipping it lost the face without
+  // a word (review of 2026-12-07): only whitespace too short to be a face or
+  // a vertex record may follow; anything more means the counts lie.
+  std::size_t shortest = std::numeric_limits<std::size_t>::max();
+  for (const PlyElement& e : h.elements) {
+    if (e.name != "vertex" && e.name != "face") continue;
+    std::size_t size = 0;
+    for (const PlyProperty& p : e.props)
+      size += std::size_t(p.list ? p.count_type.size + (p.indices ? 3 * p.type.size : 0) : p.type.size);
+    shortest = std::min(shortest, size);
+  }
   std::size_t rest = in.pos;
-  while (rest < bytes.size() && rest < in.pos + 2 && is_blank(bytes[rest])) ++rest;
+  while (rest < bytes.size() && rest - in.pos + 1 < shortest && is_blank(bytes[rest])) ++rest;
   if (rest != bytes.size())
     throw InputError(path, std::to_string(bytes.size() - in.pos) + " bytes after the last element the header declares "
                                                                  "(do the counts lie?)");

@@ -103,6 +103,26 @@ std::string quote(std::string_view token) {
 
 namespace {
 
+/// Whether `line` holds a CR followed by non-blank text that is a statement:
+/// any text on a statement line, on a comment line text starting with an OBJ
+/// keyword.
+bool cr_joins_statements(std::string_view line) {
+  std::size_t end = line.size();
+  while (end > 0 && is_blank(line[end - 1])) --end;  // trailing CRs and blanks end the line
+  line = line.substr(0, end);
+  const std::size_t cr = line.find('\r');
+  if (cr == std::string_view::npos) return false;
+  std::size_t i = 0;
+  if (next_token(line, i).substr(0, 1) != "#") return true;
+  for (std::size_t at = cr; at != std::string_view::npos; at = line.find('\r', at + 1)) {
+    std::size_t j = at + 1;
+    const std::string_view kw = next_token(line, j);
+    for (const char* k : {"v", "vt", "vn", "vp", "f", "l", "p", "o", "g", "s", "usemtl", "mtllib"})
+      if (kw == k) return true;
+  }
+  return false;
+}
+
 void scan_obj_vertex(const std::string& path, std::string& bytes, std::string_view line,
                      std::size_t& i, std::int64_t line_no, ObjScan& scan) {
   const std::size_t vertex = scan.vertices++;
@@ -123,10 +143,9 @@ void scan_obj_vertex(const std::string& path, std::string& bytes, std::string_vi
       blank_out(bytes, tok, '0');
     }
   }
-  // After x y z: nothing, w, or a color r g b (a): numbers, as OpenMesh reads
-  // them. Anything else was ignored, and `v 1 0 0<CR>v 9 9 9` lost a vertex
-  // without a word (review of 2026-12-07).
-  int extra = 0;
+  // After x y z: numbers only (w, a colour, or what an exporter adds; OpenMesh
+  // reads x y z and at most a colour). A word there was ignored, and with the
+  // CR check above it no longer hides a vertex (review of 2026-12-07).
   for (std::string_view tok = next_token(line, i); !tok.empty() && tok[0] != '#'; tok = next_token(line, i)) {
     float value = 0;
     const NumberKind kind = parse_coordinate(tok, value);
@@ -134,11 +153,7 @@ void scan_obj_vertex(const std::string& path, std::string& bytes, std::string_vi
       throw InputError(path, line_no, "vertex " + std::to_string(vertex + 1) + ": " + quote(tok) +
                                           " after the coordinates is not a number");
     if (kind == NumberKind::nonfinite) blank_out(bytes, tok, '0');  // unused; OpenMesh would skip the line
-    ++extra;
   }
-  if (extra == 2 || extra > 4)
-    throw InputError(path, line_no, "vertex " + std::to_string(vertex + 1) + " has " + std::to_string(3 + extra) +
-                                        " values; a `v` line holds x y z, then optionally w, or a color r g b (a)");
 }
 
 void scan_obj_face(const std::string& path, std::string_view line, std::size_t& i,
@@ -177,9 +192,12 @@ ObjScan scan_obj(const std::string& path, std::string& bytes) {
   LineCursor lines(bytes);
   std::string_view line;
   while (lines.next(line)) {
-    // A CR inside a line is an old Mac line end: neither pass would see the
-    // lines it separates (a CR-only file read as one line and had "no triangles").
-    if (line.find('\r') != std::string_view::npos)
+    // A CR followed by more text is an old Mac line end: neither pass would
+    // see the lines it separates (`v 1 0 0`CR`v 9 9 9` lost a vertex, a CR-only
+    // file read as one line and had "no triangles"). Trailing CRs (CR CR LF)
+    // are line ends, and a comment may hold a CR unless what follows it is a
+    // statement.
+    if (cr_joins_statements(line))
       throw InputError(path, lines.number(), "carriage return inside a line: CR-only line ends are not supported "
                                              "(use LF or CR LF)");
     std::size_t i = 0;

@@ -132,7 +132,10 @@ void trace_packet(const KdView& v, const KdPacketLanes<W>& r, const bool neg[3],
   vfloat<W> inv[3], tmin = r.tnear, tmax = r.tfar;
   for (int k = 0; k < 3; ++k) {  // detail::kd_reciprocal per lane; padding lanes: inf, never active
     const vmask<W> normal_or_zero = (r.dir[k] == 0.0f) | (abs<W>(r.dir[k]) >= 0x1p-126f);
-    const vmask<W> no_overflow = abs<W>(o[k]) + detail::kd_reach(v.bounds, k) < 0x1p127f;
+    // detail::kd_reach, written out: no std:: or detail:: function outside the ISA namespace here (simd.h).
+    const float lo = v.bounds.lo[k] < 0 ? -v.bounds.lo[k] : v.bounds.lo[k];
+    const float hi = v.bounds.hi[k] < 0 ? -v.bounds.hi[k] : v.bounds.hi[k];
+    const vmask<W> no_overflow = abs<W>(o[k]) + (lo > hi ? lo : hi) < 0x1p127f;
     inv[k] = select<W>(normal_or_zero & no_overflow, 1.0f / r.dir[k],
                        splat<W>(std::numeric_limits<float>::quiet_NaN()));
   }
