@@ -74,8 +74,9 @@ int exact_side_at(const TriangleSoup& soup, PlaneDef plane, const std::array<Pla
 /// CGAL 5.5's Mpzf::to_interval is not sound below the double range when the
 /// rounding mode is upward, as it is here (RoundingGuard): it scales by
 /// std::ldexp(1.0, e), which then rounds 2^-1216 up to the smallest subnormal
-/// instead of to 0, and CGAL takes that as an exact scale. 2^-1178 became the
-/// point [2^-1050, 2^-1050]; a cell vertex of a scene with coordinates near
+/// instead of to 0, and CGAL takes that as an exact scale: Mpzf(2^-600) *
+/// Mpzf(2^-578) = 2^-1178 becomes the point [2^-1036, 2^-1036] (in
+/// round-to-nearest, the true [0, 2^-1036]). A cell vertex of a scene with coordinates near
 /// 2^-138 was placed 2^128 times too far out, and the build ended in an
 /// internal error (a differential review of 2026-12-07; regression test "bsp
 /// build: a scene with subnormal coordinates builds, verifies and traces
