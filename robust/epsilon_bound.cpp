@@ -24,6 +24,18 @@ float float_up(double x) {
 double plane_rounding_bound(const RoundingGuard&, const PreparedPlane& plane, double s,
                             const std::array<float, 3>& n, float d,
                             std::span<const IntervalBox> vertices) {
+  // Near the float range's end the offset d or a vertex enclosure overflows:
+  // no bound (+inf), which the flattening reports. CGAL's Interval_nt asserts
+  // on an infinite endpoint (found by the sanitizer run of CI, 2026-12-07).
+  constexpr double kNoBound = std::numeric_limits<double>::infinity();
+  if (!std::isfinite(d) || !std::isfinite(s)) return kNoBound;
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(n[i]) || !std::isfinite(plane.n_lo[i]) || !std::isfinite(plane.n_hi[i]) ||
+        !std::isfinite(plane.ref[i]))
+      return kNoBound;
+  for (const IntervalBox& v : vertices)
+    for (int i = 0; i < 3; ++i)
+      if (!std::isfinite(v.lo[i]) || !std::isfinite(v.hi[i])) return kNoBound;
   IA c[3];
   IA kappa(double{d});
   for (int i = 0; i < 3; ++i) {

@@ -27,6 +27,12 @@ Sphere bounding_sphere(const RoundingGuard&, const Box3d& b) {
 }
 
 int sphere_side(const RoundingGuard&, const PreparedPlane& p, const Sphere& s) {
+  // A sphere of a box whose approximate bounds overflowed (scenes near 1e38)
+  // decides nothing; CGAL's Interval_nt asserts on an infinite endpoint
+  // (found by the sanitizer run of CI, 2026-12-07).
+  if (!std::isfinite(s.r) || !std::isfinite(s.c[0]) || !std::isfinite(s.c[1]) || !std::isfinite(s.c[2])) return 0;
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(p.n_lo[i]) || !std::isfinite(p.n_hi[i]) || !std::isfinite(p.ref[i])) return 0;
   IA v(0.0), nn(0.0);
   for (int i = 0; i < 3; ++i) {
     const IA n(p.n_lo[i], p.n_hi[i]);
