@@ -6,9 +6,10 @@
 #include <string>
 
 #include "builder/tree_file.h"
-#include "geometry/scenes/default_scene.h"
-#include "geometry/io/load_mesh.h"
+#include "geometry/core/fp_env.h"
 #include "geometry/core/triangle_soup.h"
+#include "geometry/io/load_mesh.h"
+#include "geometry/scenes/default_scene.h"
 #include "robust/degenerate.h"
 
 namespace bsprt {
@@ -35,6 +36,7 @@ Scene Scene::from_arrays(std::span<const float> vertices, std::span<const std::u
   if (indices.size() % 3 != 0)
     throw UsageError("indices: " + std::to_string(indices.size()) + " values, not a multiple of 3 (3 per triangle)");
   if (indices.empty()) throw UsageError("indices: the scene has no triangles");
+  const IeeeScope ieee;  // classify_degenerate's exact filters assume IEEE arithmetic (fp_env.h)
   auto impl = std::make_shared<Impl>();
   TriangleSoup& soup = impl->soup;
   const std::size_t nv = vertices.size() / 3;
@@ -68,6 +70,7 @@ Scene Scene::from_arrays(std::span<const float> vertices, std::span<const std::u
 
 Scene Scene::load(const std::string& path, const SceneOptions& options) {
   if (path == "default") return default_scene();
+  const IeeeScope ieee;
   auto impl = std::make_shared<Impl>();
   LoadOptions lo;
   lo.allow_nonfinite = options.allow_nonfinite;
@@ -80,6 +83,7 @@ Scene Scene::load(const std::string& path, const SceneOptions& options) {
 }
 
 Scene Scene::default_scene() {
+  const IeeeScope ieee;
   auto impl = std::make_shared<Impl>();
   impl->soup = make_default_scene();
   impl->summary = {"default", impl->soup.vertices.size(), impl->soup.unreferenced_vertex_count(), impl->soup.size(),

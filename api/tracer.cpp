@@ -6,6 +6,7 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include "builder/accel_factory.h"
+#include "geometry/core/fp_env.h"
 #include "traverse/embree/embree_tracer.h"
 #include "traverse/trace_parallel.h"
 
@@ -62,6 +63,7 @@ std::shared_ptr<Tracer::Impl> make(const Scene& scene, const std::string& accel,
 /// blocks of 4096 on an arena of `threads` (0 = all cores).
 template <typename F>
 void for_blocks(std::size_t n, const TraceOptions& o, F&& body) {
+  const IeeeScope ieee;  // this thread; for_each_block hands it to its tasks (fp_env.h)
   if (o.threads == 1) return body(std::size_t(0), n);
   auto run = [&] { for_each_block(n, 4096, body); };
   if (o.threads > 1) return tbb::task_arena(o.threads).execute(run);
@@ -98,7 +100,10 @@ std::string Tracer::name() const { return impl().name; }
 bool Tracer::certified() const { return impl().certified; }
 std::size_t Tracer::memory_bytes() const { return impl().accel->memory_bytes(); }
 
-Hit Tracer::intersect(const Ray& ray) const { return impl().accel->trace(ray); }
+Hit Tracer::intersect(const Ray& ray) const {
+  const IeeeScope ieee;  // the certified bounds assume IEEE arithmetic (fp_env.h); one MXCSR read
+  return impl().accel->trace(ray);
+}
 
 void Tracer::intersect(std::span<const Ray> rays, std::span<Hit> hits, const TraceOptions& options) const {
   check_options(options);
@@ -111,7 +116,10 @@ void Tracer::intersect(std::span<const Ray> rays, std::span<Hit> hits, const Tra
   });
 }
 
-bool Tracer::occluded(const Ray& ray) const { return impl().accel->occluded(ray); }
+bool Tracer::occluded(const Ray& ray) const {
+  const IeeeScope ieee;
+  return impl().accel->occluded(ray);
+}
 
 void Tracer::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded, const TraceOptions& options) const {
   check_options(options);

@@ -15,6 +15,7 @@
 #include "builder/kd/kd_file.h"
 #include "builder/tree_file.h"
 #include "bsprt/error.h"
+#include "geometry/core/fp_env.h"
 #include "verify/verify_file.h"
 #include "verify/verify.h"
 
@@ -54,7 +55,7 @@ std::vector<std::byte> build_kd_bytes(const TriangleSoup& soup, const BuildOptio
   m.report(0, 1);
   const KdConfig config;
   auto run = [&] { return build_kd(soup, config); };
-  KdTree tree = o.threads > 0 ? tbb::task_arena(o.threads).execute(run) : run();
+  KdTree tree = run_ieee(o.threads, run);
   m.report(1, 1);
   return kd_tree_file(tree, soup, config).bytes();
 }
@@ -81,6 +82,7 @@ Tree build(const Scene& scene, const BuildOptions& options) {
   if (options.membership != Membership::Area && options.membership != Membership::Closed)
     throw UsageError("BuildOptions::membership must be Membership::Area or Membership::Closed, not " +
                      std::to_string(int(options.membership)));
+  const IeeeScope ieee;  // flatten_bsp and the file writer on this thread (fp_env.h)
   const auto t0 = Clock::now();
   const BuildMonitor monitor{options};
   auto impl = std::make_shared<Tree::Impl>(Tree::Impl{scene, nullptr, 0.0});
@@ -93,6 +95,7 @@ Tree build(const Scene& scene, const BuildOptions& options) {
 }
 
 Tree Tree::load(const std::string& path, const Scene& scene) {
+  const IeeeScope ieee;
   auto impl = std::make_shared<Impl>(Impl{scene, std::make_shared<const TreeFileReader>(path), 0.0});
   impl->reader->check_scene(scene.soup());
   return Tree(std::move(impl));
@@ -161,7 +164,7 @@ Certificate verify(const Scene& scene, const Tree& tree, const VerifyOptions& op
   auto run = [&] {
     return file->kind() == TreeKind::Kd ? verify_kd(scene.soup(), *file) : verify_bsp_tree(scene.soup(), file, options);
   };
-  Certificate c = options.threads > 0 ? tbb::task_arena(options.threads).execute(run) : run();
+  Certificate c = run_ieee(options.threads, run);  // IEEE arithmetic in every task (fp_env.h)
   c.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return c;
 }

@@ -30,6 +30,7 @@
 #include "robust/exact_tracer.h"
 #include "traverse/simd/cpu_features.h"
 #include "traverse/trace_parallel.h"
+#include "geometry/core/fp_env.h"
 
 namespace bsprt {
 namespace {
@@ -365,6 +366,7 @@ BenchResult run_bench(const std::vector<BenchScene>& scenes, const BenchOptions&
   const Isa isa = detected_isa();
   result.isa = isa_name(isa);
   result.packet_width = isa_width(isa);
+  const IeeeScope ieee;  // this thread and, through the arena made under it, every task (fp_env.h)
   tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
   result.threads = arena.max_concurrency();
   const std::size_t total = scenes.size() * (o.modes.size() + o.ray_sets.size() * steps_per_set(o.modes.size(), o));

@@ -19,6 +19,7 @@
 #include "builder/tree_file.h"
 #include "bsprt/error.h"
 #include "bsprt/io.h"
+#include "geometry/core/fp_env.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 #include "traverse/embree/embree_tracer.h"
@@ -65,6 +66,7 @@ void run_all_hits(const TraceArgs& a) {
   const CertifiedIntersector cert(soup);
   std::vector<std::vector<CertifiedIntersector::Crossing>> per_ray(rays.size());
   tbb::combinable<RayCounters> counters;
+  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
     std::vector<std::uint32_t> candidates;
     for (std::size_t i = r.begin(); i < r.end(); ++i) {
@@ -73,7 +75,7 @@ void run_all_hits(const TraceArgs& a) {
       std::sort(per_ray[i].begin(), per_ray[i].end(),
                 [](const auto& x, const auto& y) { return x.t < y.t || (x.t == y.t && x.prim < y.prim); });
     }
-  });
+  }, ieee.context());
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ofstream out(a.hits);
   if (!out) throw InputError(a.hits, "cannot write");
@@ -115,10 +117,11 @@ FaceHitFigures count_face_hits(const TraceArgs& a, const TriangleSoup& soup, con
   const BspTree exact = read_bsp_file(a.trace.tree, soup);
   const FaceHitLocator locator(exact, soup);
   tbb::combinable<std::uint64_t> proven(0);
+  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hits.size(), 4096), [&](const auto& r) {
     for (std::size_t i = r.begin(); i < r.end(); ++i)
       proven.local() += locator.proving_node(hits[i]) != FaceHitLocator::kNone;
-  });
+  }, ieee.context());
   return {locator.stats(), proven.combine(std::plus<>())};
 }
 
@@ -141,10 +144,11 @@ RayCounters trace_all(const Accelerator& tracer, const std::vector<Ray>& rays, s
 RayCounters occlude_all(const Accelerator& tracer, const std::vector<Ray>& rays, std::vector<std::uint8_t>& occ,
                         bool count) {
   tbb::combinable<RayCounters> local;
+  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024), [&](const auto& r) {
     RayCounters* c = count ? &local.local() : nullptr;
     for (std::size_t i = r.begin(); i < r.end(); ++i) occ[i] = tracer.occluded(rays[i], c) ? 1 : 0;
-  });
+  }, ieee.context());
   return local.combine([](RayCounters x, const RayCounters& y) { return x += y; });
 }
 

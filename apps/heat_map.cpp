@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "bsprt/error.h"
+#include "geometry/core/fp_env.h"
 
 namespace bsprt {
 namespace {
@@ -101,6 +102,7 @@ HeatMetric parse_heat_metric(const std::string& name) {
 std::vector<float> pixel_costs(const Accelerator& tracer, const RenderOptions& options, HeatMetric metric, int repeats) {
   const CameraRays camera(options.camera, options.width, options.height);
   std::vector<float> cost(std::size_t(options.width) * std::size_t(options.height), 0.0f);
+  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(0, options.height, [&](int y) {
     for (int x = 0; x < options.width; ++x) {
       const Ray ray = camera.ray(x, y);
@@ -125,7 +127,7 @@ std::vector<float> pixel_costs(const Accelerator& tracer, const RenderOptions& o
                                         : float(rc.triangle_tests);
       }
     }
-  });
+  }, ieee.context());
   return cost;
 }
 

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "apps/ray_offset.h"
+#include "geometry/core/fp_env.h"
 
 namespace bsprt {
 namespace {
@@ -232,6 +233,7 @@ Image render_path(const Accelerator& tracer, const TriangleSoup& soup, const Pat
     return ThreadStats{std::vector<std::uint64_t>(depth, 0), std::vector<double>(depth, 0.0),
                        std::vector<RayCounters>(depth), options.count};
   });
+  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, total, 1), [&](const auto& range) {
     for (std::uint64_t t = range.begin(); t < range.end(); ++t) {
       const int x0 = int(t % std::uint64_t(tiles_x)) * kTile, y0 = int(t / std::uint64_t(tiles_x)) * kTile;
@@ -242,7 +244,7 @@ Image render_path(const Accelerator& tracer, const TriangleSoup& soup, const Pat
       const std::uint64_t d = done.fetch_add(1) + 1;
       if (progress) progress(d, total);
     }
-  });
+  }, ieee.context());
   if (stats) {
     *stats = {};
     stats->rays_by_bounce.assign(depth, 0);

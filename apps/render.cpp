@@ -10,6 +10,8 @@
 #include <cmath>
 #include <vector>
 
+#include "geometry/core/fp_env.h"
+
 namespace bsprt {
 namespace {
 
@@ -46,6 +48,7 @@ Image render_cast(const Accelerator& tracer, const TriangleSoup& soup, const Ren
   std::atomic<std::uint64_t> tiles_done{0};
   tbb::combinable<TileStats> per_thread;
 
+  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(tbb::blocked_range2d<int>(0, tiles_y, 1, 0, tiles_x, 1), [&](const auto& range) {
     std::vector<Ray> rays;
     std::vector<Hit> hits;
@@ -70,7 +73,7 @@ Image render_cast(const Accelerator& tracer, const TriangleSoup& soup, const Ren
         const std::uint64_t done = tiles_done.fetch_add(1) + 1;
         if (progress) progress(done, tiles_total);
       }
-  });
+  }, ieee.context());
 
   if (stats) {
     *stats = {};

@@ -12,6 +12,7 @@
 #include "builder/tree_file.h"
 #include "builder/kd/kd_file.h"
 #include "bsprt/error.h"
+#include "geometry/core/fp_env.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 #include "traverse/brute_force.h"
@@ -25,12 +26,10 @@
 namespace bsprt {
 namespace {
 
-/// Runs f on `threads` threads (0 = all).
+/// Runs f on `threads` threads (0 = all), in IEEE arithmetic (fp_env.h).
 template <typename F>
 auto with_threads(int threads, F&& f) {
-  if (threads <= 0) return f();
-  tbb::task_arena arena(threads);
-  return arena.execute(std::forward<F>(f));
+  return run_ieee(threads, std::forward<F>(f));
 }
 
 /// The tree file of `options` (in memory, or opened from tree_path), or null.
@@ -237,6 +236,7 @@ std::unique_ptr<Accelerator> make_tracer(const std::string& accel, const Triangl
       if (accel_info(name).tree != AccelTree::None) with_tree += (with_tree.empty() ? "" : ", ") + name;
     throw UsageError("a tree file works with the accelerators " + with_tree + ", not '" + accel + "'");
   }
+  const IeeeScope ieee;  // builds, tree checks and exact setup assume IEEE arithmetic (fp_env.h)
   return info.make(soup, options);
 }
 

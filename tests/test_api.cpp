@@ -11,6 +11,10 @@
 #include <limits>
 #include <vector>
 
+#if defined(__x86_64__)
+#include <xmmintrin.h>
+#endif
+
 #include "bsprt/bsprt.h"
 #include "test_util.h"
 
@@ -346,3 +350,76 @@ TEST_CASE("api: moved-from objects, empty kd trees, bad enums and single-ray err
   below.org = {0, 0, -5}, below.dir = {0, 0, 1}, below.tnear = -1.0f;
   CHECK_THROWS_WITH(Tracer::by_name(b, "embree").intersect(below), Catch::Contains("embree: the ray has tnear < 0"));
 }
+
+#if defined(__x86_64__)
+// Found 2026-12-07 (tests/test_fp_env.cpp): with flush-to-zero and
+// denormals-are-zero set on the calling thread (as Embree advises its users),
+// the exact reference missed every ray of a scene with subnormal coordinates.
+// Every public function now computes in IEEE arithmetic and gives the caller
+// its own settings back.
+TEST_CASE("api: a caller with flush-to-zero and denormals-are-zero gets the same trees, certificate and hits", "[api]") {
+  const float grid[12][3] = {{0, 5, 1}, {1, 5, 0}, {1, 6, 2}, {3, 4, 2},   {3, 5, 2}, {4, 5, 2},
+                             {1, 2, 3}, {1, 2, 5}, {2, 2, 5}, {2, 1, 4.5f}, {4, 1, 6.5f}, {2, 1, 4}};
+  std::vector<float> vertices;
+  for (const auto& g : grid)
+    for (const float c : g) vertices.push_back(std::ldexp(c, -140));  // subnormal floats
+  const std::vector<std::uint32_t> indices = {5, 4, 3, 6, 8, 7, 2, 1, 0, 9, 10, 11};
+  std::vector<bsprt::Ray> rays;  // made here, in IEEE arithmetic: FTZ would flush these directions
+  for (std::uint32_t t = 0; t < 12; ++t) {
+    bsprt::Ray r;
+    r.org = {std::ldexp(-1.0f, -140), std::ldexp(-1.0f, -140), std::ldexp(-1.0f, -140)};
+    r.dir = bsprt::Vec3f{vertices[3 * t], vertices[3 * t + 1], vertices[3 * t + 2]} - r.org;
+    rays.push_back(r);
+  }
+  struct Outcome {
+    std::vector<std::byte> kd;  // (a BSP file holds its build time)
+    bool certified = false;
+    std::vector<bsprt::Hit> exact, single, batch;
+    std::size_t degenerate = 0;
+  };
+  const auto run = [&] {
+    Outcome o;
+    const bsprt::Scene scene = bsprt::Scene::from_arrays(vertices, indices);
+    o.degenerate = scene.summary().degenerate;
+    const bsprt::Tree bsp = bsprt::build(scene);
+    bsprt::BuildOptions kd_options;
+    kd_options.kind = bsprt::TreeKind::Kd;
+    const bsprt::Tree kd = bsprt::build(scene, kd_options);
+    o.kd.assign(kd.bytes().begin(), kd.bytes().end());
+    o.certified = bsprt::verify(scene, bsp).certified;
+    const bsprt::Tracer exact = bsprt::Tracer::exact(scene);
+    const bsprt::Tracer tracer(scene, bsp);
+    o.exact.resize(rays.size());
+    exact.intersect(rays, o.exact);
+    for (const bsprt::Ray& r : rays) o.single.push_back(tracer.intersect(r));
+    o.batch.resize(rays.size());
+    tracer.intersect(rays, o.batch);
+    return o;
+  };
+  const unsigned saved = _mm_getcsr();
+  _mm_setcsr(0x1F80u);
+  REQUIRE(rays.front().dir.y == std::ldexp(6.0f, -140));  // 5 - (-1), kept as a subnormal
+  const Outcome want = run();
+  _mm_setcsr(0x1F80u | 0x8040u);  // FTZ and DAZ
+  const Outcome got = run();
+  const unsigned after = _mm_getcsr();
+  _mm_setcsr(saved);
+  CHECK((after & 0x8040u) == 0x8040u);  // the caller's settings are its own again
+  REQUIRE(want.certified);
+  CHECK(got.certified);
+  CHECK(got.degenerate == want.degenerate);
+  CHECK(got.kd == want.kd);
+  int hits = 0;
+  for (std::size_t i = 0; i < want.exact.size(); ++i) {
+    CAPTURE(i);
+    hits += want.exact[i].hit();
+    CHECK(got.exact[i].prim == want.exact[i].prim);
+    CHECK(got.exact[i].t == want.exact[i].t);
+    CHECK(got.single[i].prim == want.exact[i].prim);
+    CHECK(got.single[i].t == want.exact[i].t);
+    CHECK(got.batch[i].prim == want.exact[i].prim);
+    CHECK(got.batch[i].t == want.exact[i].t);
+  }
+  CHECK(hits >= 10);
+}
+#endif

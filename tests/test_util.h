@@ -1,24 +1,41 @@
 #pragma once
 // Helpers shared by the test programs: paths to shared scenes and temp files.
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 
 namespace bsprt::test {
 
 /// Absolute path of a mesh in ../shared/scenes.
 inline std::string scene_path(const std::string& name) { return std::string(BSPRT_SCENES_DIR) + "/" + name; }
 
-/// A fresh file path under the system temp folder (not created).
-inline std::string temp_path(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / "bsprt_tests";
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
+/// This process's own folder under the system temp folder, removed at exit.
+/// One per process: CTest runs test cases in parallel (and two checkouts may
+/// run their tests at once), and several cases use the same file names
+/// ("x.hits"); a shared folder made them overwrite each other's files.
+inline const std::filesystem::path& temp_dir() {
+  struct Dir {
+    std::filesystem::path path;
+    Dir() : path(std::filesystem::temp_directory_path() / ("bsprt_tests_" + std::to_string(::getpid()))) {
+      std::filesystem::create_directories(path);
+    }
+    ~Dir() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
 }
+
+/// A fresh file path in this process's temp folder (not created).
+inline std::string temp_path(const std::string& name) { return (temp_dir() / name).string(); }
 
 /// Exit status and everything printed (stdout and stderr) of one CLI run.
 struct CliRun {

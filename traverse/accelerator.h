@@ -14,6 +14,12 @@
 namespace bsprt {
 
 /// Nearest-hit ray tracer over one fixed scene.
+///
+/// Every method expects IEEE default arithmetic on the calling thread (no
+/// flush-to-zero, no denormals-are-zero, round to nearest): the certified
+/// bounds and the exact filters assume it, and a per-ray guard would cost every
+/// ray. Callers set it: trace_parallel's tasks, the CLI and the public API
+/// (bsprt::Tracer) run under geometry/core/fp_env.h's IeeeScope.
 class Accelerator {
  public:
   virtual ~Accelerator() = default;

@@ -401,8 +401,8 @@ template <bool kAnyHit = false, class Fr, class TStage, class Open>
       return;
     }
   }
-  float t;
-  double lo, hi;
+  float t = 0.0f;  // set by tstage when it returns Hit; zeros keep gcc's LTO from warning
+  double lo = 0.0, hi = 0.0;
   Stage ts = tstage(t, lo, hi);
   // Any hit (occluded): a t certainly in [tnear, tfar] will do, rounded or
   // not; only a hit whose enclosure reaches past the float range, at either

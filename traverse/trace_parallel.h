@@ -14,6 +14,7 @@
 #include <span>
 
 #include "bsprt/ray.h"
+#include "geometry/core/fp_env.h"
 #include "traverse/accelerator.h"
 #include "traverse/counters.h"
 
@@ -29,11 +30,15 @@ struct ParallelTrace {
   std::function<void(std::size_t)> on_block;
 };
 
-/// Runs body(begin, end) over [0, n) in blocks of `block`, on the current arena.
+/// Runs body(begin, end) over [0, n) in blocks of `block`, on the current
+/// arena, in IEEE arithmetic on every thread whatever the caller's thread or
+/// arena holds (geometry/core/fp_env.h: the certified bounds assume it).
 template <typename Body>
 void for_each_block(std::size_t n, std::size_t block, Body&& body) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, block),
-                    [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+  IeeeTasks ieee;
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n, block),
+      [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); }, ieee.context());
 }
 
 /// hits[i] = the accelerator's nearest hit of rays[i] (hits.size() == rays.size()),

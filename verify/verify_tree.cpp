@@ -12,6 +12,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "geometry/core/fp_env.h"
 #include "verify/verify_cell.h"
 #include "verify/verify_detail.h"
 
@@ -257,13 +258,10 @@ void Walk::run(std::uint32_t node, std::uint32_t flat, VCell cell, std::vector<P
 }  // namespace
 }  // namespace vfy
 
-VerifyReport verify_bsp(const TriangleSoup& soup, const VerifyInput& in, const VerifyConfig& opt) {
+namespace {
+VerifyReport verify_bsp_ieee(const TriangleSoup& soup, const VerifyInput& in, const VerifyConfig& opt) {
   using namespace vfy;
   const auto start = std::chrono::steady_clock::now();
-  std::unique_ptr<tbb::global_control> cap;
-  if (opt.threads > 0)
-    cap = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                std::size_t(opt.threads));
   VerifyReport rep;
   rep.membership = in.membership == 1 ? "area" : "closed";
   rep.coplanar_to_both = in.coplanar_to_both;
@@ -329,6 +327,18 @@ VerifyReport verify_bsp(const TriangleSoup& soup, const VerifyInput& in, const V
   rep.certified = !rep.failure.has_value();
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return rep;
+}
+}  // namespace
+
+VerifyReport verify_bsp(const TriangleSoup& soup, const VerifyInput& in, const VerifyConfig& opt) {
+  std::unique_ptr<tbb::global_control> cap;
+  if (opt.threads > 0)
+    cap = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                std::size_t(opt.threads));
+  // The interval filters and the exact fallbacks assume IEEE arithmetic in every task, whatever
+  // the caller's thread or arena holds: a plane table made with DAZ refused valid subnormal trees
+  // (fp_env.h).
+  return run_ieee(0, [&] { return verify_bsp_ieee(soup, in, opt); });
 }
 
 }  // namespace bsprt

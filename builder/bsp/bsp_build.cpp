@@ -17,6 +17,7 @@
 #include "builder/bsp/bsp_candidates.h"
 #include "bsprt/error.h"
 #include "geometry/core/check.h"
+#include "geometry/core/fp_env.h"
 
 namespace bsprt {
 
@@ -289,6 +290,7 @@ Box3f bsp_root_box(const TriangleSoup& soup, const std::vector<std::uint32_t>& t
 BspTree build_bsp(const TriangleSoup& soup, const BspConfig& config, BspBuildReport* report,
                   const BspProgressFn& progress) {
   check_threads(config.threads, "BspConfig::threads");
+  const IeeeScope ieee;  // IEEE arithmetic here and, through the arena made below, in every task (fp_env.h)
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::uint32_t> ids;
   for (std::uint32_t t = 0; t < soup.size(); ++t)
@@ -301,7 +303,7 @@ BspTree build_bsp(const TriangleSoup& soup, const BspConfig& config, BspBuildRep
   const double root_area = 2.0 * (double(d.x) * d.y + double(d.y) * d.z + double(d.z) * d.x);
   Builder builder(soup, config, progress, double(ids.size()), root_area);
   std::unique_ptr<BuildNode> root;
-  tbb::task_arena arena(config.threads > 0 ? config.threads : tbb::task_arena::automatic);
+  tbb::task_arena arena(config.threads > 0 ? config.threads : tbb::task_arena::automatic);  // under `ieee`
   arena.execute([&] { root = builder.build(Cell::box(root_box), std::move(tris), 0, double(ids.size())); });
   builder.finish();
   Flattener f;

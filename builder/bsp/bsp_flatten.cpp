@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bsprt/error.h"
+#include "geometry/core/fp_env.h"
 #include "robust/exact_side.h"
 
 namespace bsprt {
@@ -139,6 +140,7 @@ FloatPlane flat_plane_of(const TriangleSoup& soup, PlaneDef plane, const Cell& c
 }
 
 FlatBspTree flatten_bsp(const TriangleSoup& soup, const BspTree& exact, FlattenReport* report) {
+  const IeeeScope ieee;  // the plane bounds assume IEEE arithmetic (fp_env.h)
   const auto start = std::chrono::steady_clock::now();
   try {
     exact.validate(soup.size(), &soup);

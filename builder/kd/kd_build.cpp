@@ -13,6 +13,7 @@
 
 #include "builder/kd/kd_events.h"
 #include "bsprt/error.h"
+#include "geometry/core/fp_env.h"
 #include "traverse/kd/kd_traverse.h"
 
 namespace bsprt {
@@ -144,7 +145,8 @@ int kd_depth_limit(const KdConfig& config, std::size_t n) {
   return std::min(limit, kKdMaxDepth - 1);  // the traversal stack's size
 }
 
-KdTree build_kd(const TriangleSoup& soup, const KdConfig& config, KdBuildReport* report) {
+namespace {
+KdTree build_kd_ieee(const TriangleSoup& soup, const KdConfig& config, KdBuildReport* report) {
   const auto start = std::chrono::steady_clock::now();
   if (soup.size() > KdNode::kMaxOffset)
     throw UsageError("kd-tree: " + std::to_string(soup.size()) + " triangles, at most 2^30 - 1 supported");
@@ -172,6 +174,12 @@ KdTree build_kd(const TriangleSoup& soup, const KdConfig& config, KdBuildReport*
     report->dropped = ctx.dropped;
   }
   return tree;
+}
+}  // namespace
+
+KdTree build_kd(const TriangleSoup& soup, const KdConfig& config, KdBuildReport* report) {
+  // IEEE arithmetic in every task, whatever the caller's thread or arena holds (fp_env.h).
+  return run_ieee(0, [&] { return build_kd_ieee(soup, config, report); });
 }
 
 }  // namespace bsprt
