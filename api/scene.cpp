@@ -95,7 +95,10 @@ Scene Scene::default_scene() {
 std::size_t Scene::triangle_count() const { return impl().soup.size(); }
 std::size_t Scene::vertex_count() const { return impl().soup.vertices.size(); }
 const SceneSummary& Scene::summary() const { return impl().summary; }
-Box3f Scene::bounds() const { return impl().soup.bounds(); }
+Box3f Scene::bounds() const {
+  const IeeeScope ieee;
+  return impl().soup.bounds();
+}
 std::uint64_t Scene::fingerprint() const { return impl().fingerprint; }
 const TriangleSoup& Scene::soup() const { return impl().soup; }
 

@@ -106,6 +106,7 @@ Hit Tracer::intersect(const Ray& ray) const {
 }
 
 void Tracer::intersect(std::span<const Ray> rays, std::span<Hit> hits, const TraceOptions& options) const {
+  const IeeeScope ieee;  // before check_domain: DAZ would read a subnormal tnear as 0 (fp_env.h)
   check_options(options);
   if (rays.size() != hits.size())
     throw UsageError("intersect: " + std::to_string(rays.size()) + " rays but room for " + std::to_string(hits.size()) +
@@ -122,6 +123,7 @@ bool Tracer::occluded(const Ray& ray) const {
 }
 
 void Tracer::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded, const TraceOptions& options) const {
+  const IeeeScope ieee;
   check_options(options);
   if (rays.size() != occluded.size())
     throw UsageError("occluded: " + std::to_string(rays.size()) + " rays but room for " +

@@ -100,9 +100,9 @@ HeatMetric parse_heat_metric(const std::string& name) {
 }
 
 std::vector<float> pixel_costs(const Accelerator& tracer, const RenderOptions& options, HeatMetric metric, int repeats) {
+  IeeeTasks ieee;  // IEEE arithmetic here and in every task, camera set-up included (geometry/core/fp_env.h)
   const CameraRays camera(options.camera, options.width, options.height);
   std::vector<float> cost(std::size_t(options.width) * std::size_t(options.height), 0.0f);
-  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(0, options.height, [&](int y) {
     for (int x = 0; x < options.width; ++x) {
       const Ray ray = camera.ray(x, y);

@@ -136,7 +136,7 @@ void shade_bounce(const TileJob& job, int bounce, const std::vector<std::size_t>
       continue;
     }
     const auto tri = job.soup.corners(h.prim);
-    Vec3f n = normalize(cross(tri[1] - tri[0], tri[2] - tri[0]));
+    Vec3f n = job.soup.unit_normal(h.prim);
     if (dot(n, rays[k].dir) > 0) n = -n;  // face the incoming ray: both sides are diffuse
     const SurfacePoint sp = surface_point(tri, h.u, h.v);
     Sampler& rng = samplers[i];
@@ -220,6 +220,7 @@ void render_tile(const TileJob& job, int x0, int y0, int x1, int y1, Image& imag
 
 Image render_path(const Accelerator& tracer, const TriangleSoup& soup, const PathOptions& options, PathStats* stats,
                   const RenderProgress& progress) {
+  IeeeTasks ieee;  // IEEE arithmetic here and in every task, camera set-up included (geometry/core/fp_env.h)
   const auto start = std::chrono::steady_clock::now();
   Image image(options.width, options.height);
   const CameraRays camera(options.camera, options.width, options.height);
@@ -233,7 +234,6 @@ Image render_path(const Accelerator& tracer, const TriangleSoup& soup, const Pat
     return ThreadStats{std::vector<std::uint64_t>(depth, 0), std::vector<double>(depth, 0.0),
                        std::vector<RayCounters>(depth), options.count};
   });
-  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, total, 1), [&](const auto& range) {
     for (std::uint64_t t = range.begin(); t < range.end(); ++t) {
       const int x0 = int(t % std::uint64_t(tiles_x)) * kTile, y0 = int(t / std::uint64_t(tiles_x)) * kTile;

@@ -23,8 +23,7 @@ std::array<float, 3> shade(const TriangleSoup& soup, const Ray& ray, const Hit& 
     const float up = 0.5f + 0.5f * normalize(ray.dir).y;
     return {0.25f + 0.35f * up, 0.3f + 0.4f * up, 0.45f + 0.45f * up};
   }
-  const auto [a, b, c] = soup.corners(hit.prim);
-  const Vec3f n = normalize(cross(b - a, c - a));
+  const Vec3f n = soup.unit_normal(hit.prim);
   const float cosine = std::abs(dot(n, normalize(ray.dir)));
   const float k = 0.1f + 0.9f * cosine;
   return {0.85f * k, 0.78f * k, 0.68f * k};
@@ -39,6 +38,7 @@ struct TileStats {
 
 Image render_cast(const Accelerator& tracer, const TriangleSoup& soup, const RenderOptions& options,
                   RenderStats* stats, const RenderProgress& progress) {
+  IeeeTasks ieee;  // IEEE arithmetic here and in every task, camera set-up included (geometry/core/fp_env.h)
   const auto start = std::chrono::steady_clock::now();
   Image image(options.width, options.height);
   const CameraRays camera(options.camera, options.width, options.height);
@@ -48,7 +48,6 @@ Image render_cast(const Accelerator& tracer, const TriangleSoup& soup, const Ren
   std::atomic<std::uint64_t> tiles_done{0};
   tbb::combinable<TileStats> per_thread;
 
-  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(tbb::blocked_range2d<int>(0, tiles_y, 1, 0, tiles_x, 1), [&](const auto& range) {
     std::vector<Ray> rays;
     std::vector<Hit> hits;

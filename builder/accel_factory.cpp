@@ -236,8 +236,11 @@ std::unique_ptr<Accelerator> make_tracer(const std::string& accel, const Triangl
       if (accel_info(name).tree != AccelTree::None) with_tree += (with_tree.empty() ? "" : ", ") + name;
     throw UsageError("a tree file works with the accelerators " + with_tree + ", not '" + accel + "'");
   }
-  const IeeeScope ieee;  // builds, tree checks and exact setup assume IEEE arithmetic (fp_env.h)
-  return info.make(soup, options);
+  // Builds, tree checks and exact setup assume IEEE arithmetic, and Embree's scene commit sets
+  // FTZ and DAZ while it runs TBB tasks: run in an arena made under an IeeeScope, so that a
+  // thread whose first use of TBB is this call gets its implicit arena in IEEE arithmetic too
+  // (task_arena::initialize makes it) and later loops of the caller do not inherit FTZ (fp_env.h).
+  return run_ieee(options.threads, [&] { return info.make(soup, options); });
 }
 
 std::string bsp_tree_load_problem(const TriangleSoup& soup, std::shared_ptr<const TreeFileReader> file) {

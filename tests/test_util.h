@@ -23,6 +23,7 @@ inline const std::filesystem::path& temp_dir() {
   struct Dir {
     std::filesystem::path path;
     Dir() : path(std::filesystem::temp_directory_path() / ("bsprt_tests_" + std::to_string(::getpid()))) {
+      std::filesystem::remove_all(path);  // left by a killed run of the same process id
       std::filesystem::create_directories(path);
     }
     ~Dir() {

@@ -33,6 +33,13 @@ struct TriangleSoup {
     return {corner(t, 0), corner(t, 1), corner(t, 2)};
   }
   bool is_degenerate(std::uint32_t t) const { return !degenerate.empty() && degenerate[t] != 0; }
+  /// Unit normal of triangle t, (b - a) x (c - a) normalized, made in double: in
+  /// float the cross product of a triangle near 2^-130 underflows to zero and its
+  /// normal became NaN (shading). NaN for a degenerate triangle.
+  Vec3f unit_normal(std::uint32_t t) const {
+    const Vec3d a(corner(t, 0)), b(corner(t, 1)), c(corner(t, 2));
+    return Vec3f(normalize(cross(b - a, c - a)));
+  }
   /// Bounds of the corners of all non-degenerate triangles (unreferenced vertices
   /// do not count).
   Box3f bounds() const;

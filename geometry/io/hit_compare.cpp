@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "bsprt/error.h"
+#include "geometry/core/fp_env.h"
 
 namespace bsprt {
 
@@ -17,6 +18,7 @@ const char* hit_record_problem(const Hit& h) {
 }
 
 double ulp_distance(float a, float b) {
+  const IeeeScope ieee;  // DAZ would make two subnormals equal (fp_env.h)
   if (a == b) return 0.0;
   if (!std::isfinite(a) || !std::isfinite(b)) return INFINITY;
   // Map floats to a monotone integer line, so the difference counts ulps.
@@ -28,6 +30,7 @@ double ulp_distance(float a, float b) {
 }
 
 HitComparison compare_hits(std::span<const Hit> reference, std::span<const Hit> tested, double rel_tol) {
+  const IeeeScope ieee;
   if (reference.size() != tested.size())
     throw UsageError("hit files differ in size: " + std::to_string(reference.size()) + " vs " +
                      std::to_string(tested.size()) + " rays");
