@@ -2,8 +2,6 @@
 /// make_tracer: one switch from `--accel` names to tracers.
 #include "builder/accel_factory.h"
 
-#include <oneapi/tbb/task_arena.h>
-
 #include "builder/bsp/bsp_build.h"
 #include "builder/bsp/bsp_file.h"
 #include "builder/bsp/bsp_flat_io.h"
@@ -26,12 +24,6 @@
 namespace bsprt {
 namespace {
 
-/// Runs f on `threads` threads (0 = all), in IEEE arithmetic (fp_env.h).
-template <typename F>
-auto with_threads(int threads, F&& f) {
-  return run_ieee(threads, std::forward<F>(f));
-}
-
 /// The tree file of `options` (in memory, or opened from tree_path), or null.
 std::shared_ptr<const TreeFileReader> tree_file_of(const AccelOptions& options) {
   if (options.tree_file) return options.tree_file;
@@ -41,7 +33,7 @@ std::shared_ptr<const TreeFileReader> tree_file_of(const AccelOptions& options) 
 
 KdTree load_or_build_kd(const TriangleSoup& soup, const AccelOptions& options) {
   const auto file = tree_file_of(options);
-  return file ? read_kd_tree(*file, soup) : with_threads(options.threads, [&] { return build_kd(soup); });
+  return file ? read_kd_tree(*file, soup) : build_kd(soup);
 }
 
 std::unique_ptr<Accelerator> make_kd_float(const TriangleSoup& soup, const AccelOptions& options) {
@@ -194,12 +186,12 @@ constexpr AccelInfo kTable[] = {
     {"bvh8", "plain 8-wide BVH (Embree's SAH builder), Embree-style single-ray kernel, exact-decision leaf test",
      A::None, true, false, false, false, false, false,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return std::make_unique<ExactLeafTracer<Bvh8Tracer>>(s, with_threads(o.threads, [&] { return build_bvh8(s); }));
+       return std::make_unique<ExactLeafTracer<Bvh8Tracer>>(s, build_bvh8(s));
      }},
     {"bvh8-float", "plain 8-wide BVH, Embree-style single-ray kernel, float watertight leaf test", A::None, false,
      false, false, false, false, false,
      [](const TriangleSoup& s, const AccelOptions& o) -> std::unique_ptr<Accelerator> {
-       return std::make_unique<Bvh8Tracer>(with_threads(o.threads, [&] { return build_bvh8(s); }));
+       return std::make_unique<Bvh8Tracer>(build_bvh8(s));
      }},
 };
 
@@ -236,10 +228,11 @@ std::unique_ptr<Accelerator> make_tracer(const std::string& accel, const Triangl
       if (accel_info(name).tree != AccelTree::None) with_tree += (with_tree.empty() ? "" : ", ") + name;
     throw UsageError("a tree file works with the accelerators " + with_tree + ", not '" + accel + "'");
   }
-  // Builds, tree checks and exact setup assume IEEE arithmetic, and Embree's scene commit sets
-  // FTZ and DAZ while it runs TBB tasks: run in an arena made under an IeeeScope, so that a
-  // thread whose first use of TBB is this call gets its implicit arena in IEEE arithmetic too
-  // (task_arena::initialize makes it) and later loops of the caller do not inherit FTZ (fp_env.h).
+  // Builds run on options.threads threads (0 = all). Builds, tree checks and exact setup assume
+  // IEEE arithmetic, and Embree's scene commit sets FTZ and DAZ while it runs TBB tasks: run in
+  // an arena made under an IeeeScope, so that a thread whose first use of TBB is this call gets
+  // its implicit arena in IEEE arithmetic too (task_arena::initialize makes it), and later loops
+  // of the caller do not inherit FTZ (fp_env.h).
   return run_ieee(options.threads, [&] { return info.make(soup, options); });
 }
 

@@ -396,14 +396,23 @@ TEST_CASE("api: a caller with flush-to-zero and denormals-are-zero gets the same
     tracer.intersect(rays, o.batch);
     return o;
   };
-  const unsigned saved = _mm_getcsr();
-  _mm_setcsr(0x1F80u);
+  struct Mxcsr {  // sets MXCSR, and restores it also when a check throws
+    unsigned saved = _mm_getcsr();
+    explicit Mxcsr(unsigned value) { _mm_setcsr(value); }
+    ~Mxcsr() { _mm_setcsr(saved); }
+  };
   REQUIRE(rays.front().dir.y == std::ldexp(6.0f, -140));  // 5 - (-1), kept as a subnormal
-  const Outcome want = run();
-  _mm_setcsr(0x1F80u | 0x8040u);  // FTZ and DAZ
-  const Outcome got = run();
-  const unsigned after = _mm_getcsr();
-  _mm_setcsr(saved);
+  Outcome want, got;
+  unsigned after = 0;
+  {
+    const Mxcsr ieee(0x1F80u);
+    want = run();
+  }
+  {
+    const Mxcsr ftz_daz(0x1F80u | 0x8040u);
+    got = run();
+    after = _mm_getcsr();
+  }
   CHECK((after & 0x8040u) == 0x8040u);  // the caller's settings are its own again
   REQUIRE(want.certified);
   CHECK(got.certified);
