@@ -111,6 +111,17 @@ TEST_CASE("bvh8: the tree is valid, holds every usable triangle and catches corr
   t.nodes[0].child[0] = Bvh8Node::inner_ref(std::uint32_t(t.nodes.size()));  // out of range
   CHECK_THROWS_AS(t.validate(), std::logic_error);
   t = good;
+  // The SoA rows' triangle number (what a float hit reports) no longer the list's:
+  // row 9 of the leaf whose entries start at 0.
+  std::uint32_t n0 = 0;
+  for (const Bvh8Node& n : good.nodes)
+    for (const std::uint32_t ref : n.child)
+      if (ref != 0 && Bvh8Node::is_leaf(ref) && Bvh8Node::index(ref) == 0) n0 = Bvh8Node::count(ref);
+  REQUIRE(n0 >= 1);
+  float& number = t.leaf_soa[9 * n0];
+  number = std::bit_cast<float>(std::bit_cast<std::uint32_t>(number) + 1);
+  CHECK_THROWS_WITH(t.validate(), Catch::Contains("SoA triangle number and list differ"));
+  t = good;
   t.prims[0] = t.prims[1];  // one triangle twice, another in no leaf
   CHECK_THROWS_AS(t.validate(), std::logic_error);
   CHECK_THROWS_AS(Bvh8Tracer(std::move(t)), UsageError);
@@ -180,6 +191,74 @@ TEST_CASE("bvh8: the plain x86-64, AVX2 and AVX-512 kernels agree bit for bit, h
     CHECK(cw.leaf_visits == cr.leaf_visits);
     CHECK(cw.triangle_tests == cr.triangle_tests);
   }
+}
+
+// trace_batch runs the kernel's own loop (no virtual call or ISA switch per
+// ray); it must give what trace() gives ray by ray, counters included, with
+// rays from beyond 2^126 (the fallback) mixed in, and in a scene beyond 2^126.
+TEST_CASE("bvh8: trace_batch equals trace() ray by ray, hits and counters, on every kernel", "[bvh8]") {
+  const auto same = [](const Accelerator& a, const std::vector<Ray>& rays) {
+    std::vector<Hit> single(rays.size()), batch(rays.size());
+    RayCounters cs, cb;
+    for (std::size_t i = 0; i < rays.size(); ++i) single[i] = a.trace(rays[i], &cs);
+    a.trace_batch(rays, batch, 1, &cb);
+    std::size_t bad = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) bad += std::memcmp(&single[i], &batch[i], sizeof(Hit)) != 0 ? 1 : 0;
+    CHECK(bad == 0);
+    CHECK(cb.rays == rays.size());
+    CHECK(cb.rays == cs.rays);
+    CHECK(cb.box_node_visits == cs.box_node_visits);
+    CHECK(cb.leaf_visits == cs.leaf_visits);
+    CHECK(cb.triangle_tests == cs.triangle_tests);
+    CHECK(cb.rule_decisions == cs.rule_decisions);
+    CHECK(cb.exact_decisions == cs.exact_decisions);
+    std::vector<Hit> uncounted(rays.size());
+    a.trace_batch(rays, uncounted);
+    CHECK(std::memcmp(uncounted.data(), batch.data(), rays.size() * sizeof(Hit)) == 0);
+    std::size_t hits = 0;
+    for (const Hit& h : batch) hits += h.hit() ? 1 : 0;
+    return hits;
+  };
+  const TriangleSoup soup = load_mesh(test::scene_path("utah-teapot.obj"));
+  std::vector<Ray> rays = test_rays(soup, 500);
+  // Rays from beyond 2^126 towards the scene, between the others.
+  Ray far;
+  far.org = {0x1p127f, 0.5f, 0.5f};
+  far.dir = {-1, 0, 0};
+  rays.insert(rays.begin() + 7, far);
+  far.org = {0.5f, -std::numeric_limits<float>::max(), 0.5f};
+  far.dir = {0, 1, 0};
+  rays.insert(rays.begin() + 300, far);
+  const ExactTracer exact(soup);
+  std::vector<Hit> ref(rays.size());
+  exact.trace_batch(rays, ref);
+  CHECK(ref[7].hit());
+  CHECK(ref[300].hit());
+  const CertifiedIntersector certified(soup);
+  for (const bool exact_leaves : {true, false}) {
+    for (const Isa isa : {Isa::Scalar, Isa::Avx2, Isa::Avx512}) {
+      if (int(detected_isa()) < int(isa)) continue;
+      INFO((exact_leaves ? "bvh8" : "bvh8-float") << " on the " << isa_name(isa) << " kernel");
+      Bvh8Tracer t(build_bvh8(soup));
+      if (exact_leaves) t.set_exact_leaf(&certified);
+      t.set_kernel_isa(isa);
+      CHECK(same(t, rays) > rays.size() / 4);
+      std::vector<Hit> h(rays.size());
+      t.trace_batch(rays, h);
+      CHECK(h[7].hit());
+      CHECK(h[300].hit());
+      if (exact_leaves) {  // t and prim equal the exact reference's on every ray (u, v are computed differently)
+        std::size_t bad = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i)
+          bad += (h[i].prim != ref[i].prim || (h[i].hit() && h[i].t != ref[i].t)) ? 1 : 0;
+        CHECK(bad == 0);
+      }
+    }
+  }
+  // A scene beyond 2^126: the batch takes the fallback for every ray.
+  const TriangleSoup huge = transformed_soup(make_icosphere({0, 0, 0}, 1.0f, 2), 0x1p100f, {0x1p126f, 0, 0});
+  const auto hb = exact_bvh8(huge);
+  CHECK(same(*hb, random_rays(huge, 300, 5)) > 50);
 }
 
 TEST_CASE("bvh8: counters, and counted hits equal uncounted ones", "[bvh8]") {

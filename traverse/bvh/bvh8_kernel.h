@@ -5,6 +5,8 @@
 /// share, and their entry points.
 
 #include <bit>
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "bsprt/ray.h"
@@ -63,12 +65,32 @@ inline Bvh8RayRecip bvh8_reciprocals(const Ray& ray) {
   return r;
 }
 
+/// The kernels trace a ray whose origin lies within 2^126 of 0 in every
+/// coordinate (so that p - o cannot overflow in the box test); Bvh8Tracer
+/// traces any other ray against every triangle.
+inline constexpr float kBvh8Huge = 0x1p126f;
+inline bool bvh8_origin_in_range(const Ray& ray) {
+  return std::fabs(ray.org.x) <= kBvh8Huge && std::fabs(ray.org.y) <= kBvh8Huge && std::fabs(ray.org.z) <= kBvh8Huge;
+}
+
+/// Traces a ray the kernels do not take (bvh8_origin_in_range false).
+using Bvh8FallbackFn = Hit (*)(const void* ctx, const Ray& ray, RayCounters* c);
+
 /// Nearest hit of one ray; counts into c when non-null. Call the AVX2 and
 /// AVX-512 ones only when detected_isa() supports them; the base one (plain
 /// x86-64) runs anywhere. All three return the same hits, bit for bit.
 Hit bvh8_trace_avx512(const Bvh8View& view, const Ray& ray, RayCounters* c);
 Hit bvh8_trace_avx2(const Bvh8View& view, const Ray& ray, RayCounters* c);
 Hit bvh8_trace_base(const Bvh8View& view, const Ray& ray, RayCounters* c);
+/// rays[i] into hits[i] for i < n: what the single-ray entry does ray by ray,
+/// with the kernel inlined into the loop (no call and no ISA switch per ray).
+/// Rays out of range go to fallback(ctx, ray, c).
+void bvh8_trace_batch_avx512(const Bvh8View& view, const Ray* rays, Hit* hits, std::size_t n, RayCounters* c,
+                             Bvh8FallbackFn fallback, const void* ctx);
+void bvh8_trace_batch_avx2(const Bvh8View& view, const Ray* rays, Hit* hits, std::size_t n, RayCounters* c,
+                           Bvh8FallbackFn fallback, const void* ctx);
+void bvh8_trace_batch_base(const Bvh8View& view, const Ray* rays, Hit* hits, std::size_t n, RayCounters* c,
+                           Bvh8FallbackFn fallback, const void* ctx);
 /// Any hit in [tnear, tfar]: the same traversal, stopped at the first hit.
 bool bvh8_occluded_avx512(const Bvh8View& view, const Ray& ray, RayCounters* c);
 bool bvh8_occluded_avx2(const Bvh8View& view, const Ray& ray, RayCounters* c);

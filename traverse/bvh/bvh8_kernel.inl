@@ -35,8 +35,8 @@
 #include "traverse/simd/simd.h"
 #include "traverse/watertight.h"
 
-#if !defined(BSPRT_BVH8_ENTRY) || !defined(BSPRT_BVH8_OCCLUDED)
-#error "define BSPRT_BVH8_ENTRY and BSPRT_BVH8_OCCLUDED before including bvh8_kernel.inl"
+#if !defined(BSPRT_BVH8_ENTRY) || !defined(BSPRT_BVH8_OCCLUDED) || !defined(BSPRT_BVH8_BATCH)
+#error "define BSPRT_BVH8_ENTRY, BSPRT_BVH8_OCCLUDED and BSPRT_BVH8_BATCH before including bvh8_kernel.inl"
 #endif
 
 namespace bsprt::detail {
@@ -109,7 +109,7 @@ template <bool kSubtrees>
 inline void prefetch_ref(const Bvh8View& v, std::uint32_t ref) {
   if (Bvh8Node::is_leaf(ref)) {
     if (kSubtrees && Bvh8Node::count(ref) == Bvh8Node::kSubtree) return;
-    const char* p = reinterpret_cast<const char*>(v.leaf_soa + 9 * std::size_t(Bvh8Node::index(ref)));
+    const char* p = reinterpret_cast<const char*>(v.leaf_soa + Bvh8Tree::kSoaFloats * std::size_t(Bvh8Node::index(ref)));
     __builtin_prefetch(p);
     __builtin_prefetch(p + 64);
     if (Bvh8Node::count(ref) > 1) __builtin_prefetch(p + 128);
@@ -154,13 +154,12 @@ inline void sort_keys_desc(std::uint32_t* k, int n) {
 }
 
 /// The watertight test (watertight.h) of one ray against the `count` (1..4)
-/// triangles of a leaf at once, SoA rows at `rows` (bvh8_node.h), triangle
-/// numbers at `prims`: lane by lane the same IEEE operations in the same
+/// triangles of a leaf at once, SoA rows at `rows` (bvh8_node.h, the tenth
+/// row holding the triangle numbers): lane by lane the same IEEE operations in the same
 /// order, lanes with an exactly zero edge function redone by the same double
 /// fallback, so the result is the scalar leaf loop's bit for bit: the
 /// smallest t in [tnear, tfar] below hit.t, the earliest lane among equal t.
-inline void intersect_leaf(const WatertightRay& r, const float* rows, const std::uint32_t* prims,
-                           std::uint32_t count, Hit& hit) {
+inline void intersect_leaf(const WatertightRay& r, const float* rows, std::uint32_t count, Hit& hit) {
   using V4 = simd::vfloat<4>;
   using M4 = simd::vmask<4>;
   const auto lane = [&](int c, int k) { return simd::load<4>(rows + (3 * c + k) * count); };
@@ -186,10 +185,15 @@ inline void intersect_leaf(const WatertightRay& r, const float* rows, const std:
     }
   }
   const M4 neg = (u < 0.0f) | (v < 0.0f) | (w < 0.0f), pos = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
+  // A leaf the ray passes beside (every live lane with edge functions of both
+  // signs) ends here, before the determinant and the division, as Embree's
+  // leaf tests end on an empty mask.
+  const M4 inside = live & ~(neg & pos);
+  if (!simd::any<4>(inside)) return;
   const V4 det = u + v + w;
   const V4 tz = no_fma(u * (sz * az)) + no_fma(v * (sz * bz)) + no_fma(w * (sz * cz));
   const V4 t = tz / det;
-  const M4 ok = live & ~(neg & pos) & (det != 0.0f) & (t >= r.tnear) & (t <= r.tfar) &
+  const M4 ok = inside & (det != 0.0f) & (t >= r.tnear) & (t <= r.tfar) &
                 (t < std::numeric_limits<float>::infinity()) & (t < hit.t);
   unsigned m = simd::movemask<4>(ok);
   if (m == 0) return;
@@ -200,7 +204,7 @@ inline void intersect_leaf(const WatertightRay& r, const float* rows, const std:
   }
   const float rcp = 1.0f / det[best];
   hit.t = t[best];
-  hit.prim = prims[best];
+  hit.prim = std::bit_cast<std::uint32_t>(rows[9 * count + unsigned(best)]);
   hit.u = v[best] * rcp;
   hit.v = w[best] * rcp;
 }
@@ -297,7 +301,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       if (v.exact_leaf) {
         // Triangles the float filter proves missed never reach the exact test.
         if (!sheared) wr = watertight_precompute(ray), sheared = true, filter = filterable(wr, ray);
-        const float* rows = v.leaf_soa + 9 * std::size_t(first);
+        const float* rows = v.leaf_soa + Bvh8Tree::kSoaFloats * std::size_t(first);
         const unsigned all = (1u << count) - 1u;
         const unsigned lanes = filter ? exact_lanes(wr, rows, count) : all;
         if (lanes == all) {
@@ -338,7 +342,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       } else {
         if constexpr (kCount) c->triangle_tests += count;
         if (!sheared) wr = watertight_precompute(ray), sheared = true;
-        intersect_leaf(wr, v.leaf_soa + 9 * std::size_t(first), v.prims + first, count, hit);
+        intersect_leaf(wr, v.leaf_soa + Bvh8Tree::kSoaFloats * std::size_t(first), count, hit);
         if (kAnyHit && hit.hit()) return hit;
         tfar = hit.t < tfar ? hit.t : tfar;
       }
@@ -381,6 +385,15 @@ Hit trace_counted(const Bvh8View& v, const Ray& ray, RayCounters* c) {
 
 Hit BSPRT_BVH8_ENTRY(const Bvh8View& view, const Ray& ray, RayCounters* c) {
   return c ? trace_counted<true, false>(view, ray, c) : trace_counted<false, false>(view, ray, nullptr);
+}
+
+void BSPRT_BVH8_BATCH(const Bvh8View& view, const Ray* rays, Hit* hits, std::size_t n, RayCounters* c,
+                      Bvh8FallbackFn fallback, const void* ctx) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Ray& r = rays[i];
+    if (!bvh8_origin_in_range(r)) hits[i] = fallback(ctx, r, c);
+    else hits[i] = c ? trace_counted<true, false>(view, r, c) : trace_counted<false, false>(view, r, nullptr);
+  }
 }
 
 bool BSPRT_BVH8_OCCLUDED(const Bvh8View& view, const Ray& ray, RayCounters* c) {

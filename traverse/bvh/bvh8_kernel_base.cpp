@@ -6,4 +6,5 @@
 #pragma GCC diagnostic ignored "-Wpsabi"
 #define BSPRT_BVH8_ENTRY bvh8_trace_base
 #define BSPRT_BVH8_OCCLUDED bvh8_occluded_base
+#define BSPRT_BVH8_BATCH bvh8_trace_batch_base
 #include "traverse/bvh/bvh8_kernel.inl"

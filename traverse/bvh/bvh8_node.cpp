@@ -2,6 +2,8 @@
 /// Bvh8Node helpers and Bvh8Tree::validate.
 #include "traverse/bvh/bvh8_node.h"
 
+#include <bit>
+
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -58,11 +60,13 @@ struct Checker {
       const std::uint32_t n = Bvh8Node::count(ref);
       if (n > Bvh8Node::kMaxLeafSize) fail("leaf at " + std::to_string(i) + " holds more than four triangles");
       if (std::uint64_t(i) + n > t.prims.size()) fail("leaf list " + std::to_string(i) + " out of range");
-      const float* rows = t.leaf_soa.data() + 9 * std::size_t(i);
+      const float* rows = t.leaf_soa.data() + Bvh8Tree::kSoaFloats * std::size_t(i);
       for (std::uint32_t j = i; j < i + n; ++j) {
         const std::uint32_t p = t.prims[j];
         if (p >= t.scene_triangles) fail("leaf entry " + std::to_string(j) + " names no triangle");
         if (seen_prim[p]++ && !t.over_bsp) fail("triangle " + std::to_string(p) + " in two leaves");
+        if (std::bit_cast<std::uint32_t>(rows[9 * n + (j - i)]) != p)
+          fail("leaf entry " + std::to_string(j) + ": SoA triangle number and list differ");
         for (int c = 0; c < 3; ++c) {
           const Vec3f& q = t.triangles[j].v[c];
           for (int k = 0; k < 3; ++k)
@@ -100,7 +104,8 @@ struct Checker {
 void Bvh8Tree::validate() const {
   if (nodes.empty()) throw std::logic_error("bvh8: no root node");
   if (prims.size() != triangles.size()) throw std::logic_error("bvh8: prims and triangles differ in size");
-  if (leaf_soa.size() != 9 * prims.size() + 3) throw std::logic_error("bvh8: leaf_soa is not 9 floats per entry + 3");
+  if (leaf_soa.size() != kSoaFloats * prims.size() + 3)
+    throw std::logic_error("bvh8: leaf_soa is not " + std::to_string(kSoaFloats) + " floats per entry + 3");
   Checker c{*this, std::vector<std::uint8_t>(nodes.size(), 0), std::vector<std::uint8_t>(scene_triangles, 0),
             std::vector<std::uint8_t>(subtrees.size(), 0)};
   c.seen_node[0] = 1;

@@ -22,9 +22,11 @@
 /// A leaf's triangles are stored twice. For the float kernel, which tests
 /// them at once in four lanes (as Embree tests its Triangle4 leaves), in SoA
 /// form without padding: nine rows of n floats (corner c, axis k at row
-/// 3c + k) from leaf_soa[9 first]; a row is loaded as four floats, lanes past
-/// n masked off (leaf_soa ends with three spare floats). For the exact leaf
-/// test's interface, as lists in leaf order: prims and triangles from first.
+/// 3c + k) from leaf_soa[10 first], then a tenth row of the n triangle
+/// numbers (their bits), so that a hit reads its number from the lines the
+/// test has loaded; a row is loaded as four floats, lanes past n masked off
+/// (leaf_soa ends with three spare floats). For the exact leaf test's
+/// interface, as lists in leaf order: prims and triangles from first.
 
 #include <cstdint>
 #include <span>
@@ -78,7 +80,9 @@ struct Bvh8Subtree {
 /// says that no hit is lost (docs/bvh8.md, "BSP subtrees below").
 struct Bvh8Tree {
   std::vector<Bvh8Node> nodes;
-  std::vector<float> leaf_soa;  ///< 9 floats per leaf entry (see the file comment), then 3 spare
+  /// Floats per leaf entry in leaf_soa: nine corner coordinates and the triangle number's bits.
+  static constexpr std::uint32_t kSoaFloats = 10;
+  std::vector<float> leaf_soa;  ///< kSoaFloats per leaf entry (see the file comment), then 3 spare
   std::vector<std::uint32_t> prims;
   std::vector<LeafTriangle> triangles;  ///< corners of prims[i] at triangles[i]
   std::uint32_t depth = 0;              ///< levels of inner nodes (root = 1)

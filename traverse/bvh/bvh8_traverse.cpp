@@ -15,8 +15,6 @@ namespace bsprt {
 
 namespace {
 
-constexpr float kHuge = 0x1p126f;
-
 float max_abs(const Vec3f& p) { return std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}); }
 
 }  // namespace
@@ -30,7 +28,7 @@ Bvh8Tracer::Bvh8Tracer(Bvh8Tree tree) : tree_(std::move(tree)) {
   if (tree_.depth > detail::kBvh8MaxDepth)
     throw UsageError("bvh8 tree deeper than " + std::to_string(detail::kBvh8MaxDepth) + " levels");
   for (const LeafTriangle& t : tree_.triangles)
-    for (const Vec3f& p : t.v) huge_scene_ = huge_scene_ || !(max_abs(p) <= kHuge);
+    for (const Vec3f& p : t.v) huge_scene_ = huge_scene_ || !(max_abs(p) <= detail::kBvh8Huge);
   isa_ = detected_isa() >= Isa::Avx2 ? detected_isa() : Isa::Scalar;
 }
 
@@ -91,16 +89,34 @@ bool Bvh8Tracer::run_occluded(const detail::Bvh8View& v, const Ray& ray, RayCoun
 
 Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
   if (tree_.over_bsp) throw UsageError("bvh8: a tree over a BSP is traced through its BspTracer");
-  if (huge_scene_ || !(max_abs(ray.org) <= kHuge)) {
+  if (huge_scene_ || !detail::bvh8_origin_in_range(ray)) {
     if (counters) ++counters->rays;
     return is_valid(ray) ? trace_every_triangle(ray, counters) : Hit{};
   }
   return run(view(), ray, counters);
 }
 
+void Bvh8Tracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
+                             RayCounters* counters) const {
+  if (tree_.over_bsp) throw UsageError("bvh8: a tree over a BSP is traced through its BspTracer");
+  if (huge_scene_) return Accelerator::trace_batch(rays, hits, packet_width, counters);
+  const auto fallback = [](const void* ctx, const Ray& ray, RayCounters* c) {
+    return static_cast<const Bvh8Tracer*>(ctx)->trace(ray, c);
+  };
+  const detail::Bvh8View v = view();
+  switch (isa_) {
+    case Isa::Avx512:
+      return detail::bvh8_trace_batch_avx512(v, rays.data(), hits.data(), rays.size(), counters, fallback, this);
+    case Isa::Avx2:
+      return detail::bvh8_trace_batch_avx2(v, rays.data(), hits.data(), rays.size(), counters, fallback, this);
+    default:
+      return detail::bvh8_trace_batch_base(v, rays.data(), hits.data(), rays.size(), counters, fallback, this);
+  }
+}
+
 bool Bvh8Tracer::occluded(const Ray& ray, RayCounters* counters) const {
   if (tree_.over_bsp) throw UsageError("bvh8: a tree over a BSP is traced through its BspTracer");
-  if (huge_scene_ || !(max_abs(ray.org) <= kHuge)) return trace(ray, counters).hit();
+  if (huge_scene_ || !detail::bvh8_origin_in_range(ray)) return trace(ray, counters).hit();
   return run_occluded(view(), ray, counters);
 }
 

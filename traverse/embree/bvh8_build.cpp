@@ -6,6 +6,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <bit>
 #include <span>
 #include <new>
 #include <stdexcept>
@@ -62,12 +63,13 @@ struct Flattener {
   std::uint32_t put_leaf(const std::uint32_t* prims, const LeafTriangle* tris, std::uint32_t n) {
     const auto first = std::uint32_t(tree.prims.size());
     const std::size_t rows = tree.leaf_soa.size();
-    tree.leaf_soa.resize(rows + 9 * std::size_t(n));
+    tree.leaf_soa.resize(rows + Bvh8Tree::kSoaFloats * std::size_t(n));
     for (std::uint32_t i = 0; i < n; ++i) {
       tree.prims.push_back(prims[i]);
       tree.triangles.push_back(tris[i]);
       for (int j = 0; j < 3; ++j)
         for (int k = 0; k < 3; ++k) tree.leaf_soa[rows + (3 * j + k) * n + i] = tris[i].v[j][k];
+      tree.leaf_soa[rows + 9 * n + i] = std::bit_cast<float>(prims[i]);
     }
     return Bvh8Node::leaf_ref(first, n);
   }
