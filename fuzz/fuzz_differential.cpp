@@ -16,7 +16,8 @@
 //   - kd or bsp packets (every width this CPU runs) differ from the same
 //     tree's single rays in any bit of any hit or in any counter: the packet
 //     kernels promise the single-ray sequence of nodes and leaves per lane, or
-//   - bvh8-float's plain x86-64 kernel differs from its AVX2 or AVX-512 kernel in any bit.
+//   - bvh8-float's plain x86-64 kernel differs from its AVX2 or AVX-512 kernel in any bit,
+//     or a kernel's batch loop from its single rays.
 // (bvh8-float and bsp-bvh8-float are not compared with brute force: their boxes are exact, so a
 // float hit on a triangle whose box the exact ray just misses is not found;
 // docs/bvh8.md.)
@@ -156,22 +157,28 @@ void expect_packets_equal(const char* accel, const bsprt::Accelerator& t, std::s
   }
 }
 
-/// The BVH8's plain x86-64 kernel equals its AVX2 and AVX-512 kernels bit for bit.
+/// The BVH8's plain x86-64 kernel equals its AVX2 and AVX-512 kernels bit for bit,
+/// and each kernel's batch loop (trace_batch) equals its single rays.
 void expect_bvh8_kernels_equal(bsprt::Accelerator& t, std::span<const bsprt::Ray> rays) {
   auto& bvh = dynamic_cast<bsprt::Bvh8Tracer&>(t);
   bvh.set_kernel_isa(bsprt::Isa::Scalar);
   const std::vector<bsprt::Hit> base = trace(bvh, rays);
-  for (const bsprt::Isa isa : {bsprt::Isa::Avx2, bsprt::Isa::Avx512}) {
-    if (int(bsprt::detected_isa()) < int(isa)) continue;
-    bvh.set_kernel_isa(isa);
-    const std::vector<bsprt::Hit> wide = trace(bvh, rays);
+  const auto expect_same = [&](const char* what, bsprt::Isa isa, const std::vector<bsprt::Hit>& got) {
     for (std::size_t i = 0; i < rays.size(); ++i)
-      if (std::memcmp(&base[i], &wide[i], sizeof(bsprt::Hit)) != 0) {
-        std::fprintf(stderr, "bvh8-float %s: ray %zu: base t=%a prim=%u, wide t=%a prim=%u\n",
-                     bsprt::isa_name(isa).c_str(), i, double(base[i].t), base[i].prim, double(wide[i].t),
-                     wide[i].prim);
+      if (std::memcmp(&base[i], &got[i], sizeof(bsprt::Hit)) != 0) {
+        std::fprintf(stderr, "bvh8-float %s %s: ray %zu: base t=%a prim=%u, got t=%a prim=%u\n",
+                     bsprt::isa_name(isa).c_str(), what, i, double(base[i].t), base[i].prim, double(got[i].t),
+                     got[i].prim);
         __builtin_trap();
       }
+  };
+  for (const bsprt::Isa isa : {bsprt::Isa::Scalar, bsprt::Isa::Avx2, bsprt::Isa::Avx512}) {
+    if (int(bsprt::detected_isa()) < int(isa)) continue;
+    bvh.set_kernel_isa(isa);
+    expect_same("single rays", isa, trace(bvh, rays));
+    std::vector<bsprt::Hit> batch(rays.size());
+    bvh.trace_batch(rays, batch);
+    expect_same("batch", isa, batch);
   }
 }
 
@@ -206,7 +213,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   expect_agree("bsp-top vs exact", exact, trace(*make("bsp-top", soup, 1), rays));
   expect_agree("bsp-top-float vs brute", brute, trace(*make("bsp-top-float", soup, 1), rays));
   expect_agree("kd vs exact", exact, trace(*make("kd", soup), rays));
-  expect_agree("bvh8 vs exact", exact, trace(*make("bvh8", soup), rays));
+  {
+    const auto bvh8 = make("bvh8", soup);
+    expect_agree("bvh8 vs exact", exact, trace(*bvh8, rays));
+    std::vector<bsprt::Hit> batch(rays.size());
+    bvh8->trace_batch(rays, batch);
+    expect_agree("bvh8 batch vs exact", exact, batch);
+  }
   expect_agree("bsp-bvh8 vs exact", exact, trace(*make("bsp-bvh8", soup, 1), rays));
   expect_agree("bsp-bvh8 (8 slots) vs exact", exact, trace(*make("bsp-bvh8", soup, 8), rays));
   expect_bvh8_kernels_equal(*make("bvh8-float", soup), rays);

@@ -119,8 +119,12 @@ TEST_CASE("bvh8: the tree is valid, holds every usable triangle and catches corr
       if (ref != 0 && Bvh8Node::is_leaf(ref) && Bvh8Node::index(ref) == 0) n0 = Bvh8Node::count(ref);
   REQUIRE(n0 >= 1);
   float& number = t.leaf_soa[9 * n0];
-  number = std::bit_cast<float>(std::bit_cast<std::uint32_t>(number) + 1);
+  CHECK(Bvh8Tree::decode_prim(number) == t.prims[0]);
+  CHECK(std::isnormal(number));  // never a subnormal in lanes the four-float loads compute on
+  number = Bvh8Tree::encode_prim(t.prims[0] + 1);
   CHECK_THROWS_WITH(t.validate(), Catch::Contains("SoA triangle number and list differ"));
+  for (const std::uint32_t p : {0u, 1u, 0x7fffffu, 0x800000u, 0xffffffu, 0x3fffffffu, 0xfffffffeu, 0xffffffffu})
+    CHECK(Bvh8Tree::decode_prim(Bvh8Tree::encode_prim(p)) == p);
   t = good;
   t.prims[0] = t.prims[1];  // one triangle twice, another in no leaf
   CHECK_THROWS_AS(t.validate(), std::logic_error);

@@ -204,7 +204,7 @@ inline void intersect_leaf(const WatertightRay& r, const float* rows, std::uint3
   }
   const float rcp = 1.0f / det[best];
   hit.t = t[best];
-  hit.prim = std::bit_cast<std::uint32_t>(rows[9 * count + unsigned(best)]);
+  hit.prim = Bvh8Tree::decode_prim(rows[9 * count + unsigned(best)]);
   hit.u = v[best] * rcp;
   hit.v = w[best] * rcp;
 }

@@ -2,8 +2,6 @@
 /// Bvh8Node helpers and Bvh8Tree::validate.
 #include "traverse/bvh/bvh8_node.h"
 
-#include <bit>
-
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -65,7 +63,7 @@ struct Checker {
         const std::uint32_t p = t.prims[j];
         if (p >= t.scene_triangles) fail("leaf entry " + std::to_string(j) + " names no triangle");
         if (seen_prim[p]++ && !t.over_bsp) fail("triangle " + std::to_string(p) + " in two leaves");
-        if (std::bit_cast<std::uint32_t>(rows[9 * n + (j - i)]) != p)
+        if (Bvh8Tree::decode_prim(rows[9 * n + (j - i)]) != p)
           fail("leaf entry " + std::to_string(j) + ": SoA triangle number and list differ");
         for (int c = 0; c < 3; ++c) {
           const Vec3f& q = t.triangles[j].v[c];

@@ -23,11 +23,12 @@
 /// them at once in four lanes (as Embree tests its Triangle4 leaves), in SoA
 /// form without padding: nine rows of n floats (corner c, axis k at row
 /// 3c + k) from leaf_soa[10 first], then a tenth row of the n triangle
-/// numbers (their bits), so that a hit reads its number from the lines the
-/// test has loaded; a row is loaded as four floats, lanes past n masked off
+/// numbers (Bvh8Tree::encode_prim), so that a hit reads its number from the
+/// lines the test has loaded; a row is loaded as four floats, lanes past n masked off
 /// (leaf_soa ends with three spare floats). For the exact leaf test's
 /// interface, as lists in leaf order: prims and triangles from first.
 
+#include <bit>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -80,8 +81,15 @@ struct Bvh8Subtree {
 /// says that no hit is lost (docs/bvh8.md, "BSP subtrees below").
 struct Bvh8Tree {
   std::vector<Bvh8Node> nodes;
-  /// Floats per leaf entry in leaf_soa: nine corner coordinates and the triangle number's bits.
+  /// Floats per leaf entry in leaf_soa: nine corner coordinates and the triangle number.
   static constexpr std::uint32_t kSoaFloats = 10;
+  /// The number row holds triangle p as the float with bits p + 0x3f800000
+  /// (1.0 for triangle 0, below 4.0 up to 2^24 triangles): the four-float
+  /// loads of row 8 read it into lanes that are masked off but still
+  /// computed, and plain bits would be subnormal there, which some CPUs
+  /// slow down for (a microcode assist on every such product).
+  static float encode_prim(std::uint32_t p) { return std::bit_cast<float>(p + 0x3f800000u); }
+  static std::uint32_t decode_prim(float f) { return std::bit_cast<std::uint32_t>(f) - 0x3f800000u; }
   std::vector<float> leaf_soa;  ///< kSoaFloats per leaf entry (see the file comment), then 3 spare
   std::vector<std::uint32_t> prims;
   std::vector<LeafTriangle> triangles;  ///< corners of prims[i] at triangles[i]

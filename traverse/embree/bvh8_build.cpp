@@ -6,7 +6,6 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
-#include <bit>
 #include <span>
 #include <new>
 #include <stdexcept>
@@ -69,7 +68,7 @@ struct Flattener {
       tree.triangles.push_back(tris[i]);
       for (int j = 0; j < 3; ++j)
         for (int k = 0; k < 3; ++k) tree.leaf_soa[rows + (3 * j + k) * n + i] = tris[i].v[j][k];
-      tree.leaf_soa[rows + 9 * n + i] = std::bit_cast<float>(prims[i]);
+      tree.leaf_soa[rows + 9 * n + i] = Bvh8Tree::encode_prim(prims[i]);
     }
     return Bvh8Node::leaf_ref(first, n);
   }
