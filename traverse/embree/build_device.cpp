@@ -51,7 +51,8 @@ EmbreeBuild::EmbreeBuild(std::vector<RTCBuildPrimitive>& prims, std::size_t coun
   args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
   args.maxBranchingFactor = s.branching;
   args.maxDepth = s.max_depth;
-  args.minLeafSize = 1;
+  args.minLeafSize = s.min_leaf_size;
+  args.sahBlockSize = s.sah_block_size;
   args.maxLeafSize = s.max_leaf_size;
   args.traversalCost = s.traversal_cost;
   args.intersectionCost = s.intersection_cost;

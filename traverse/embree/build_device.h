@@ -19,7 +19,9 @@ namespace bsprt::detail {
 struct EmbreeBuildSettings {
   unsigned branching = 4;         ///< maxBranchingFactor
   unsigned max_depth = 64;        ///< maxDepth
-  unsigned max_leaf_size = 1;     ///< maxLeafSize (minLeafSize is 1)
+  unsigned max_leaf_size = 1;     ///< maxLeafSize
+  unsigned min_leaf_size = 1;     ///< minLeafSize: nodes of at most this many primitives are not split
+  unsigned sah_block_size = 1;    ///< sahBlockSize: a leaf costs intersection_cost per started block
   float traversal_cost = 1.0f;    ///< SAH cost of a node
   float intersection_cost = 1.0f;  ///< SAH cost of a primitive
   RTCCreateNodeFunction create_node = nullptr;

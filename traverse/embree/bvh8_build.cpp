@@ -149,7 +149,8 @@ struct Flattener {
 
   /// Runs Embree's builder over prims[0..count) (capacity 2 count) and copies its tree under the root.
   void build(std::vector<RTCBuildPrimitive>& prims, std::size_t count, unsigned max_leaf_size,
-             float traversal_cost, float intersection_cost) {
+             float traversal_cost, float intersection_cost, unsigned min_leaf_size = 1,
+             unsigned sah_block_size = 1) {
     tree.nodes.push_back(Bvh8Node::empty());  // the root, filled below
     tree.depth = 1;
     if (count > 0) {
@@ -160,6 +161,8 @@ struct Flattener {
       settings.max_leaf_size = max_leaf_size;
       settings.traversal_cost = traversal_cost;
       settings.intersection_cost = intersection_cost;
+      settings.min_leaf_size = min_leaf_size;
+      settings.sah_block_size = sah_block_size;
       settings.create_node = create_node;
       settings.set_children = set_children;
       settings.set_bounds = set_bounds;
@@ -196,6 +199,11 @@ Bvh8Tree build_bvh8(const TriangleSoup& soup, const Bvh8Config& config) {
   if (config.max_leaf_size < 1 || config.max_leaf_size > Bvh8Node::kMaxLeafSize)
     throw UsageError("bvh8: max_leaf_size must be 1.." + std::to_string(Bvh8Node::kMaxLeafSize) + ", got " +
                      std::to_string(config.max_leaf_size));
+  if (config.min_leaf_size < 1 || config.min_leaf_size > config.max_leaf_size)
+    throw UsageError("bvh8: min_leaf_size must be 1..max_leaf_size (" + std::to_string(config.max_leaf_size) +
+                     "), got " + std::to_string(config.min_leaf_size));
+  if (config.sah_block_size < 1)
+    throw UsageError("bvh8: sah_block_size must be at least 1");
   std::vector<RTCBuildPrimitive> prims;
   prims.reserve(soup.size());
   std::uint32_t left_out = 0;
@@ -212,7 +220,8 @@ Bvh8Tree build_bvh8(const TriangleSoup& soup, const Bvh8Config& config) {
   f.soup = &soup;
   f.tree.scene_triangles = std::uint32_t(soup.size());
   f.tree.left_out = left_out;
-  f.build(prims, prims.size(), config.max_leaf_size, config.traversal_cost, config.intersection_cost);
+  f.build(prims, prims.size(), config.max_leaf_size, config.traversal_cost, config.intersection_cost,
+          config.min_leaf_size, config.sah_block_size);
   return std::move(f.tree);
 }
 
