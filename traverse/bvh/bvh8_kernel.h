@@ -83,7 +83,8 @@ Hit bvh8_trace_avx512(const Bvh8View& view, const Ray& ray, RayCounters* c);
 Hit bvh8_trace_avx2(const Bvh8View& view, const Ray& ray, RayCounters* c);
 Hit bvh8_trace_base(const Bvh8View& view, const Ray& ray, RayCounters* c);
 /// rays[i] into hits[i] for i < n: what the single-ray entry does ray by ray,
-/// with the kernel inlined into the loop (no call and no ISA switch per ray).
+/// the loop inside the ISA's kernel file (no virtual call, ISA switch or
+/// tracer checks per ray; GCC keeps the kernel a direct call).
 /// Rays out of range go to fallback(ctx, ray, c).
 void bvh8_trace_batch_avx512(const Bvh8View& view, const Ray* rays, Hit* hits, std::size_t n, RayCounters* c,
                              Bvh8FallbackFn fallback, const void* ctx);

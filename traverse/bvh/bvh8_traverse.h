@@ -37,8 +37,8 @@ class Bvh8Tracer final : public Accelerator {
   /// A ray whose origin, or a scene whose corners, exceed 2^126 in magnitude
   /// (where p - o could overflow) is traced against every triangle instead.
   Hit trace(const Ray& ray, RayCounters* counters = nullptr) const override;
-  /// trace() for every ray, with the kernel's loop inside the ISA's kernel
-  /// (no virtual call or ISA switch per ray); single rays whatever packet_width.
+  /// trace() for every ray, the loop inside the ISA's kernel file (no
+  /// virtual call or ISA switch per ray); single rays whatever packet_width.
   void trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width = 1,
                    RayCounters* counters = nullptr) const override;
   /// Any hit in [tnear, tfar]: the nearest-hit traversal stopped at the first
