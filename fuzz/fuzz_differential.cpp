@@ -175,7 +175,7 @@ void expect_bvh8_kernels_equal(bsprt::Accelerator& t, std::span<const bsprt::Ray
   for (const bsprt::Isa isa : {bsprt::Isa::Scalar, bsprt::Isa::Avx2, bsprt::Isa::Avx512}) {
     if (int(bsprt::detected_isa()) < int(isa)) continue;
     bvh.set_kernel_isa(isa);
-    expect_same("single rays", isa, trace(bvh, rays));
+    if (isa != bsprt::Isa::Scalar) expect_same("single rays", isa, trace(bvh, rays));  // Scalar's are `base`
     std::vector<bsprt::Hit> batch(rays.size());
     bvh.trace_batch(rays, batch);
     expect_same("batch", isa, batch);

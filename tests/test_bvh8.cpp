@@ -291,6 +291,10 @@ TEST_CASE("bvh8: trace_batch equals trace() ray by ray, hits and counters, on ev
       }
     }
   }
+  // Fewer hits than rays is a usage error, not a write past the end.
+  Bvh8Tracer t(build_bvh8(soup));
+  std::vector<Hit> short_hits(rays.size() - 1);
+  CHECK_THROWS_AS(t.trace_batch(rays, short_hits), UsageError);
   // A scene beyond 2^126: the batch takes the fallback for every ray.
   const TriangleSoup huge = transformed_soup(make_icosphere({0, 0, 0}, 1.0f, 2), 0x1p100f, {0x1p126f, 0, 0});
   const auto hb = exact_bvh8(huge);

@@ -9,6 +9,7 @@
 
 #include "bsprt/error.h"
 #include "traverse/bvh/bvh8_kernel.h"
+#include "traverse/simd/cpu_features.h"
 #include "traverse/watertight.h"
 
 namespace bsprt {
@@ -99,6 +100,7 @@ Hit Bvh8Tracer::trace(const Ray& ray, RayCounters* counters) const {
 void Bvh8Tracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int packet_width,
                              RayCounters* counters) const {
   if (tree_.over_bsp) throw UsageError("bvh8: a tree over a BSP is traced through its BspTracer");
+  check_trace_batch(rays.size(), hits.size(), 1);  // as many hits as rays; single rays whatever packet_width
   if (huge_scene_) return Accelerator::trace_batch(rays, hits, packet_width, counters);
   const auto fallback = [](const void* ctx, const Ray& ray, RayCounters* c) {
     return static_cast<const Bvh8Tracer*>(ctx)->trace(ray, c);
