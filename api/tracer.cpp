@@ -3,12 +3,10 @@
 /// (builder/accel_factory.h) made over a Scene, with a tree from memory.
 #include "bsprt/tracer.h"
 
-#include <oneapi/tbb/task_arena.h>
-
+#include "api/blocks.h"
 #include "builder/accel_factory.h"
 #include "geometry/core/fp_env.h"
 #include "traverse/embree/embree_tracer.h"
-#include "traverse/trace_parallel.h"
 
 namespace bsprt {
 
@@ -59,17 +57,6 @@ std::shared_ptr<Tracer::Impl> make(const Scene& scene, const std::string& accel,
       Tracer::Impl{scene, make_tracer(accel, scene.soup(), options), accel, accel_info(accel).certified});
 }
 
-/// Runs body(begin, end) over [0, n): on the calling thread (threads = 1) or in
-/// blocks of 4096 on an arena of `threads` (0 = all cores).
-template <typename F>
-void for_blocks(std::size_t n, const TraceOptions& o, F&& body) {
-  const IeeeScope ieee;  // this thread; for_each_block hands it to its tasks (fp_env.h)
-  if (o.threads == 1) return body(std::size_t(0), n);
-  auto run = [&] { for_each_block(n, 4096, body); };
-  if (o.threads > 1) return tbb::task_arena(o.threads).execute(run);
-  run();
-}
-
 /// Embree traces a subset of the valid rays (embree_cannot_trace): name the
 /// first it cannot by its index in the whole batch, before any block runs
 /// (inside a block the tracer knows only the index within that block).
@@ -112,7 +99,7 @@ void Tracer::intersect(std::span<const Ray> rays, std::span<Hit> hits, const Tra
     throw UsageError("intersect: " + std::to_string(rays.size()) + " rays but room for " + std::to_string(hits.size()) +
                      " hits");
   check_domain(impl(), rays);
-  for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
+  api::for_blocks(rays.size(), options.threads, [&](std::size_t b, std::size_t e) {
     impl().accel->trace_batch(rays.subspan(b, e - b), hits.subspan(b, e - b), options.packet_width);
   });
 }
@@ -129,7 +116,7 @@ void Tracer::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occlude
     throw UsageError("occluded: " + std::to_string(rays.size()) + " rays but room for " +
                      std::to_string(occluded.size()) + " answers");
   check_domain(impl(), rays);
-  for_blocks(rays.size(), options, [&](std::size_t b, std::size_t e) {
+  api::for_blocks(rays.size(), options.threads, [&](std::size_t b, std::size_t e) {
     if (options.packet_width <= 1) {  // single rays: the tracer's own any-hit query (the BVH8 stops at a first hit)
       for (std::size_t i = b; i < e; ++i) occluded[i] = impl().accel->occluded(rays[i]) ? 1 : 0;
       return;

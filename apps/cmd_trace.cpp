@@ -21,7 +21,7 @@
 #include "bsprt/io.h"
 #include "geometry/core/fp_env.h"
 #include "robust/certified_intersector.h"
-#include "robust/exact_tracer.h"
+#include "robust/inside_query.h"
 #include "traverse/embree/embree_tracer.h"
 #include "traverse/trace_parallel.h"
 
@@ -62,19 +62,13 @@ void run_all_hits(const TraceArgs& a) {
   const std::vector<Ray> rays = read_rays(a.rays);
   const std::size_t invalid = count_invalid(rays);
   const auto t0 = std::chrono::steady_clock::now();
-  const ExactTracer exact(soup);
-  const CertifiedIntersector cert(soup);
+  const InsideQuery query(soup);
   std::vector<std::vector<CertifiedIntersector::Crossing>> per_ray(rays.size());
   tbb::combinable<RayCounters> counters;
   IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
     std::vector<std::uint32_t> candidates;
-    for (std::size_t i = r.begin(); i < r.end(); ++i) {
-      exact.touched(rays[i], candidates);
-      cert.crossings(rays[i], candidates, per_ray[i], &counters.local());
-      std::sort(per_ray[i].begin(), per_ray[i].end(),
-                [](const auto& x, const auto& y) { return x.t < y.t || (x.t == y.t && x.prim < y.prim); });
-    }
+    for (std::size_t i = r.begin(); i < r.end(); ++i) query.crossings(rays[i], candidates, per_ray[i], &counters.local());
   }, ieee.context());
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ofstream out(a.hits);

@@ -324,6 +324,61 @@ PYBIND11_MODULE(_bsprt, m) {
           },
           py::arg("rays"), py::arg("threads") = 0, py::arg("packet_width") = 1);
 
+  py::class_<bsprt::MeshQuery>(m, "_MeshQuery")
+      .def(py::init([](const bsprt::Scene& scene) {
+             py::gil_scoped_release release;  // the exact reference's AABB tree
+             return bsprt::MeshQuery(scene);
+           }),
+           py::arg("scene"))
+      .def_property_readonly("open_or_inconsistent_edges",
+                             [](const bsprt::MeshQuery& q) {
+                               py::gil_scoped_release release;
+                               return q.open_or_inconsistent_edges();
+                             })
+      .def(
+          "_sides",
+          [](const bsprt::MeshQuery& q, const py::array& points, int threads) {
+            require<float>(points, "points", 3);
+            const std::span<const bsprt::Vec3f> in(reinterpret_cast<const bsprt::Vec3f*>(points.data()),
+                                                   std::size_t(points.shape(0)));
+            py::array_t<std::uint8_t> sides(py::ssize_t(in.size()));
+            std::span<bsprt::PointSide> out(reinterpret_cast<bsprt::PointSide*>(sides.mutable_data()), in.size());
+            bsprt::QueryOptions o;
+            o.threads = threads;
+            {
+              py::gil_scoped_release release;
+              q.sides(in, out, o);
+            }
+            return sides;
+          },
+          py::arg("points"), py::arg("threads") = 0)
+      .def(
+          "_all_hits",
+          [](const bsprt::MeshQuery& q, const py::array& rays, int threads) {
+            const std::span<const Ray> in = rays_of(rays);
+            bsprt::QueryOptions o;
+            o.threads = threads;
+            std::vector<bsprt::Crossing> xs;
+            {
+              py::gil_scoped_release release;
+              xs = q.all_hits(in, o);
+            }
+            const py::ssize_t n = py::ssize_t(xs.size());
+            py::array_t<std::int64_t> ray(n);
+            py::array_t<std::uint32_t> prim(n);
+            py::array_t<float> t(n);
+            py::array_t<std::int8_t> side(n);
+            for (py::ssize_t i = 0; i < n; ++i) {
+              const bsprt::Crossing& x = xs[std::size_t(i)];
+              ray.mutable_at(i) = std::int64_t(x.ray);
+              prim.mutable_at(i) = x.prim;
+              t.mutable_at(i) = x.t;
+              side.mutable_at(i) = std::int8_t(x.side);
+            }
+            return py::make_tuple(ray, prim, t, side);
+          },
+          py::arg("rays"), py::arg("threads") = 0);
+
   m.def(
       "read_rays",
       [](const py::object& path) {

@@ -63,4 +63,13 @@ PointSide InsideQuery::side(const Vec3f& p, RayCounters* counters) const {
   return crossings.size() % 2 == 1 ? PointSide::Inside : PointSide::Outside;
 }
 
+void InsideQuery::crossings(const Ray& ray, std::vector<std::uint32_t>& candidates,
+                            std::vector<CertifiedIntersector::Crossing>& out, RayCounters* counters) const {
+  const std::size_t first = out.size();
+  exact_.touched(ray, candidates);
+  cert_.crossings(ray, candidates, out, counters);
+  std::sort(out.begin() + std::ptrdiff_t(first), out.end(),
+            [](const auto& x, const auto& y) { return x.t < y.t || (x.t == y.t && x.prim < y.prim); });
+}
+
 }  // namespace bsprt

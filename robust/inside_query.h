@@ -9,14 +9,16 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "bsprt/query.h"
 #include "geometry/core/triangle_soup.h"
 #include "robust/certified_intersector.h"
 #include "robust/exact_tracer.h"
 
 namespace bsprt {
 
-enum class PointSide : std::uint8_t { Outside, Inside, OnSurface };
+// PointSide (Outside, Inside, OnSurface) is the public API's (bsprt/query.h).
 
 /// "outside", "inside", "surface".
 std::string point_side_name(PointSide s);
@@ -32,6 +34,11 @@ class InsideQuery {
   explicit InsideQuery(const TriangleSoup& soup);
   /// Where p lies. Non-finite points are Outside.
   PointSide side(const Vec3f& p, RayCounters* counters = nullptr) const;
+  /// Every crossing of `ray` with t in [tnear, tfar], exactly, appended to
+  /// `out` ordered by t, then triangle: what `bsprt trace --all-hits` writes
+  /// for one ray. `candidates` is scratch space.
+  void crossings(const Ray& ray, std::vector<std::uint32_t>& candidates,
+                 std::vector<CertifiedIntersector::Crossing>& out, RayCounters* counters = nullptr) const;
   /// The direction of the parity rays (fixed; any direction gives the same
   /// answers on a closed mesh).
   static Vec3f ray_direction() { return {1.0f, 0.375f, 0.1875f}; }

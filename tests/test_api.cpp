@@ -7,8 +7,10 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <iterator>
 #include <limits>
+#include <sstream>
 #include <vector>
 
 #if defined(__x86_64__)
@@ -351,6 +353,117 @@ TEST_CASE("api: moved-from objects, empty kd trees, bad enums and single-ray err
   CHECK_THROWS_WITH(Tracer::by_name(b, "embree").intersect(below), Catch::Contains("embree: the ray has tnear < 0"));
 }
 
+TEST_CASE("api: MeshQuery answers what bsprt inside and trace --all-hits write", "[api][inside]") {
+  const std::string obj = test::temp_path("api-torus.obj");
+  REQUIRE(test::bsprt_cli("gen torus -o " + obj).status == 0);
+  const Scene scene = Scene::load(obj);
+  const MeshQuery query(scene);
+  CHECK(query.open_or_inconsistent_edges() == 0);
+  CHECK(MeshQuery(Scene::default_scene()).open_or_inconsistent_edges() > 0);  // the ground grid has a border
+
+  // Points: every corner (on the surface), every centroid (rounded: near it),
+  // and a 16^3 grid over the box grown by a tenth (inside the tube and out).
+  std::vector<Vec3f> points;
+  for (std::size_t t = 0; t < scene.triangle_count(); ++t) {
+    const Vec3f a = scene.corner(t, 0), b = scene.corner(t, 1), c = scene.corner(t, 2);
+    points.push_back(a);
+    points.push_back({(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3, (a.z + b.z + c.z) / 3});
+  }
+  const Box3f box = scene.bounds();
+  const Vec3f lo = box.lo - (box.hi - box.lo) * 0.1f, step = (box.hi - box.lo) * (1.2f / 15);
+  for (int i = 0; i < 16; ++i)
+    for (int j = 0; j < 16; ++j)
+      for (int k = 0; k < 16; ++k) points.push_back({lo.x + step.x * i, lo.y + step.y * j, lo.z + step.z * k});
+  const std::string pts = test::temp_path("api-torus.points"), out = test::temp_path("api-torus.sides");
+  {
+    std::ofstream f(pts);
+    f << std::setprecision(9);  // enough digits that every float reads back as itself
+    for (const Vec3f& p : points) f << p.x << ' ' << p.y << ' ' << p.z << '\n';
+  }
+  const test::CliRun r = test::bsprt_cli("inside " + obj + " " + pts + " -o " + out);
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  std::vector<PointSide> want;
+  {
+    std::ifstream in(out);
+    for (std::string line; std::getline(in, line);)
+      want.push_back(line == "inside" ? PointSide::Inside : line == "outside" ? PointSide::Outside : PointSide::OnSurface);
+  }
+  REQUIRE(want.size() == points.size());
+  std::size_t count[3] = {0, 0, 0};
+  for (const PointSide s : want) ++count[int(s)];
+  CHECK(count[int(PointSide::Inside)] > 50);
+  CHECK(count[int(PointSide::Outside)] > 1000);
+  CHECK(count[int(PointSide::OnSurface)] >= scene.triangle_count());  // at least the corners
+  for (const int threads : {1, 2, 0}) {
+    INFO("threads " << threads);
+    std::vector<PointSide> got(points.size());
+    QueryOptions o;
+    o.threads = threads;
+    query.sides(points, got, o);
+    CHECK(got == want);
+  }
+  for (std::size_t i = 0; i < points.size(); i += 97) CHECK(query.side(points[i]) == want[i]);
+
+  // All hits: the rows of the CLI's CSV, t bit for bit.
+  const std::string rays = test::temp_path("api-torus.rays"), csv = test::temp_path("api-torus.csv");
+  REQUIRE(test::bsprt_cli("gen-rays " + obj + " --kind vertex -n 2000 --seed 5 -o " + rays).status == 0);
+  REQUIRE(test::bsprt_cli("trace " + obj + " " + rays + " --all-hits -o " + csv).status == 0);
+  std::vector<Crossing> rows;
+  {
+    std::ifstream in(csv);
+    std::string line;
+    std::getline(in, line);
+    REQUIRE(line == "ray,prim,t,side");
+    while (std::getline(in, line)) {
+      std::istringstream s(line);
+      std::string field[4];
+      for (auto& f : field) std::getline(s, f, ',');
+      rows.push_back(Crossing{std::stoull(field[0]), std::uint32_t(std::stoul(field[1])), std::strtof(field[2].c_str(), nullptr),
+                              std::stoi(field[3])});
+    }
+  }
+  const std::vector<Ray> rs = read_rays(rays);
+  CHECK(rows.size() > rs.size());  // rays aimed at vertices cross the torus at least twice
+  const auto same = [](const std::vector<Crossing>& a, const std::vector<Crossing>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (a[i].ray != b[i].ray || a[i].prim != b[i].prim || std::memcmp(&a[i].t, &b[i].t, sizeof(float)) != 0 ||
+          a[i].side != b[i].side)
+        return false;
+    return true;
+  };
+  for (const int threads : {1, 0}) {
+    QueryOptions o;
+    o.threads = threads;
+    CHECK(same(query.all_hits(rs, o), rows));
+  }
+  std::vector<Crossing> first;  // crossings() of one ray: that ray's rows, with ray = 0
+  for (const Crossing& x : rows)
+    if (x.ray == 7) first.push_back(Crossing{0, x.prim, x.t, x.side});
+  CHECK(!first.empty());
+  CHECK(same(query.crossings(rs[7]), first));
+  int sum = 0;  // a whole line through a closed mesh leaves it as often as it enters
+  Ray line = rs[7];
+  line.tnear = -std::numeric_limits<float>::infinity();
+  for (const Crossing& x : query.crossings(line)) sum += x.side;
+  CHECK(sum == 0);
+
+  // Bad input: a clear UsageError, before anything is answered.
+  std::vector<Vec3f> bad = {points[0], {0.0f, std::nanf(""), 0.0f}};
+  std::vector<PointSide> two(2), one(1);
+  CHECK_THROWS_WITH(query.sides(bad, two), Catch::Contains("point 1 has a NaN or infinite coordinate"));
+  CHECK_THROWS_AS(query.side(bad[1]), UsageError);
+  CHECK_THROWS_WITH(query.sides(points, one), Catch::Contains("room for 1 answers"));
+  QueryOptions negative;
+  negative.threads = -1;
+  CHECK_THROWS_AS(query.all_hits(rs, negative), UsageError);
+  MeshQuery moved = query;
+  const MeshQuery kept = std::move(moved);
+  CHECK_THROWS_WITH(moved.side(points[0]), Catch::Contains("moved from"));
+  CHECK(kept.side(points[0]) == PointSide::OnSurface);
+}
+
 #if defined(__x86_64__)
 // Found 2026-12-07 (tests/test_fp_env.cpp): with flush-to-zero and
 // denormals-are-zero set on the calling thread (as Embree advises its users),
@@ -371,11 +484,15 @@ TEST_CASE("api: a caller with flush-to-zero and denormals-are-zero gets the same
     r.dir = bsprt::Vec3f{vertices[3 * t], vertices[3 * t + 1], vertices[3 * t + 2]} - r.org;
     rays.push_back(r);
   }
+  std::vector<bsprt::Vec3f> points;  // the corners (on the surface), made here in IEEE arithmetic too
+  for (std::uint32_t v = 0; v < 12; ++v) points.push_back({vertices[3 * v], vertices[3 * v + 1], vertices[3 * v + 2]});
   struct Outcome {
     std::vector<std::byte> kd;  // (a BSP file holds its build time)
     bool certified = false;
     std::vector<bsprt::Hit> exact, single, batch;
     std::size_t degenerate = 0;
+    std::vector<bsprt::PointSide> sides;
+    std::size_t crossings = 0;
   };
   const auto run = [&] {
     Outcome o;
@@ -394,6 +511,10 @@ TEST_CASE("api: a caller with flush-to-zero and denormals-are-zero gets the same
     for (const bsprt::Ray& r : rays) o.single.push_back(tracer.intersect(r));
     o.batch.resize(rays.size());
     tracer.intersect(rays, o.batch);
+    const bsprt::MeshQuery query(scene);  // the exact inside and all-hits queries too
+    o.sides.resize(points.size());
+    query.sides(points, o.sides);
+    o.crossings = query.all_hits(rays).size();
     return o;
   };
   struct Mxcsr {  // sets MXCSR, and restores it also when a check throws
@@ -417,6 +538,10 @@ TEST_CASE("api: a caller with flush-to-zero and denormals-are-zero gets the same
   REQUIRE(want.certified);
   CHECK(got.certified);
   CHECK(got.degenerate == want.degenerate);
+  CHECK(want.sides == std::vector<bsprt::PointSide>(want.sides.size(), bsprt::PointSide::OnSurface));
+  CHECK(got.sides == want.sides);
+  CHECK(want.crossings > 0);
+  CHECK(got.crossings == want.crossings);
   CHECK(got.kd == want.kd);
   int hits = 0;
   for (std::size_t i = 0; i < want.exact.size(); ++i) {

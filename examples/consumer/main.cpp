@@ -1,7 +1,8 @@
 // consumer MESH: loads a mesh with the installed bsprt, builds the exact BSP,
 // verifies it, traces a grid of rays towards the scene's centre in certified
-// mode and compares them with the exact reference. Exit 0 when certified and
-// equal, 1 otherwise.
+// mode and compares them with the exact reference, and lists every crossing
+// of the same rays (MeshQuery), none of which may lie before the nearest hit.
+// Exit 0 when certified and equal, 1 otherwise.
 #include <bsprt/bsprt.h>
 
 #include <cstdio>
@@ -30,11 +31,14 @@ int main(int argc, char** argv) {
     bsprt::Tracer(scene, tree, "certified").intersect(rays, hits);
     bsprt::Tracer::exact(scene).intersect(rays, ref);
     const bsprt::HitComparison cmp = bsprt::compare_hits(ref, hits);
-    std::printf("bsprt %s: %zu triangles, tree %s, %llu rays, %llu hit, lost %llu, farther %llu\n", bsprt::version(),
-                scene.triangle_count(), cert.certified ? "CERTIFIED" : cert.failure.c_str(),
+    const std::vector<bsprt::Crossing> crossings = bsprt::MeshQuery(scene).all_hits(rays);
+    bool ordered = true;  // a crossing is a hit, so never nearer than the nearest one
+    for (const bsprt::Crossing& x : crossings) ordered = ordered && ref[x.ray].hit() && x.t >= ref[x.ray].t;
+    std::printf("bsprt %s: %zu triangles, tree %s, %llu rays, %llu hit, lost %llu, farther %llu, %zu crossings\n",
+                bsprt::version(), scene.triangle_count(), cert.certified ? "CERTIFIED" : cert.failure.c_str(),
                 (unsigned long long)cmp.rays, (unsigned long long)(cmp.rays - cmp.both_miss),
-                (unsigned long long)cmp.lost, (unsigned long long)cmp.farther);
-    return cert.certified && cmp.agrees() && cmp.same_triangle + cmp.both_miss == cmp.rays ? 0 : 1;
+                (unsigned long long)cmp.lost, (unsigned long long)cmp.farther, crossings.size());
+    return cert.certified && cmp.agrees() && cmp.same_triangle + cmp.both_miss == cmp.rays && ordered ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "consumer: %s\n", e.what());
     return 1;

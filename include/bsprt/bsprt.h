@@ -8,6 +8,7 @@
 #include "bsprt/compare.h"
 #include "bsprt/error.h"
 #include "bsprt/io.h"
+#include "bsprt/query.h"
 #include "bsprt/ray.h"
 #include "bsprt/scene.h"
 #include "bsprt/tracer.h"

@@ -22,12 +22,14 @@ import numpy as np
 from ._bsprt import (HIT_DTYPE, Cancelled, InputError, Tree, __version__, compare,
                      read_hits, read_rays, write_hits, write_rays)
 from ._bsprt import Scene
-from ._bsprt import _Tracer
+from ._bsprt import _MeshQuery, _Tracer
 
 __all__ = ["Scene", "Tree", "Tracer", "Hits", "HIT_DTYPE", "NO_HIT", "InputError", "Cancelled", "compare",
-           "read_rays", "write_rays", "read_hits", "write_hits", "make_rays", "__version__"]
+           "read_rays", "write_rays", "read_hits", "write_hits", "make_rays", "MeshQuery", "Crossings",
+           "OUTSIDE", "INSIDE", "SURFACE", "__version__"]
 
 NO_HIT = 0xFFFFFFFF
+OUTSIDE, INSIDE, SURFACE = 0, 1, 2  # MeshQuery.sides codes (bsprt::PointSide)
 
 
 class Hits(NamedTuple):
@@ -156,3 +158,50 @@ class Tracer:
                  packet_width: int = 1) -> np.ndarray:
         """True where the ray hits anything in [tnear, tfar] (shadow / any-hit rays)."""
         return self.occluded_rays(make_rays(origins, directions, tnear, tfar), threads, packet_width)
+
+
+class Crossings(NamedTuple):
+    """Every crossing of every ray (MeshQuery.all_hits), ordered by ray, then t, then
+    triangle: the rows of `bsprt trace --all-hits`."""
+    ray: np.ndarray   # int64: index of the ray
+    prim: np.ndarray  # uint32: triangle number
+    t: np.ndarray     # float32: the exact t rounded to the nearest float
+    side: np.ndarray  # int8: +1 or -1, the sign of n . dir with n = (v1 - v0) x (v2 - v0)
+
+
+class MeshQuery:
+    """Exact queries on a closed mesh (docs/api.md, "Inside and all hits"): where
+    points lie, by exact parity with simulation of simplicity, and every crossing
+    of a ray. Builds the exact reference's AABB tree once."""
+
+    def __init__(self, scene):
+        self._q = _MeshQuery(scene)
+        self._scene = scene
+
+    @property
+    def open_or_inconsistent_edges(self) -> int:
+        """Edges used by other than two triangles, or twice in one direction: 0 for a
+        closed, consistently oriented mesh, where inside and outside are defined."""
+        return self._q.open_or_inconsistent_edges
+
+    def sides(self, points, threads: int = 0) -> np.ndarray:
+        """OUTSIDE, INSIDE or SURFACE (uint8) for each point of an (N, 3) array. Float64
+        (or integer) points are rounded to the nearest float32, as mesh coordinates
+        are; a NaN or infinite point is a ValueError."""
+        p = _numbers("points", points)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ValueError(f"points: expected shape (N, 3), got {p.shape}")
+        return self._q._sides(np.ascontiguousarray(_to_float32("points", p)), threads)
+
+    def contains(self, points, threads: int = 0) -> np.ndarray:
+        """True where a point is inside the mesh or on its surface (closed solid)."""
+        return self.sides(points, threads) != OUTSIDE
+
+    def all_hits_rays(self, rays: np.ndarray, threads: int = 0) -> Crossings:
+        """Every crossing of each ray of an (N, 8) float32 array of .rays records."""
+        return Crossings(*self._q._all_hits(_rays_array(rays), threads))
+
+    def all_hits(self, origins, directions, tnear=None, tfar=None, threads: int = 0) -> Crossings:
+        """Every crossing with t in [tnear, tfar] (defaults 0 and inf), each edge or
+        vertex crossing counted once."""
+        return self.all_hits_rays(make_rays(origins, directions, tnear, tfar), threads)

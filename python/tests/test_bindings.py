@@ -320,3 +320,64 @@ def test_compare_counts_a_wrong_t_on_the_right_triangle(scenes):
     broken["t"] = np.nan
     with pytest.raises(ValueError, match="not finite"):
         bsprt.compare(hits, broken)
+
+
+def test_mesh_query_equals_cli_inside_and_all_hits(tmp_path):
+    obj = tmp_path / "torus.obj"
+    cli("gen", "torus", "-o", obj)
+    scene = bsprt.Scene.load(obj)
+    q = bsprt.MeshQuery(scene)
+    assert q.open_or_inconsistent_edges == 0
+    assert bsprt.MeshQuery(bsprt.Scene.default()).open_or_inconsistent_edges > 0
+    # float64 points on a grid over the box, plus float32 points near the surface
+    (lo, hi) = (np.array(b, dtype=np.float64) for b in scene.bounds)
+    g = np.linspace(0.0, 1.0, 13)
+    grid = lo - 0.1 * (hi - lo) + 1.2 * (hi - lo) * np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    rays = bsprt.read_rays(_vertex_rays(tmp_path, obj))
+    aimed = rays[:200, 0:3] + rays[:200, 4:7]  # the vertex rays' targets, rounded: on or next to the surface
+    points = np.concatenate([grid, aimed.astype(np.float64)])
+    pts = tmp_path / "points.txt"
+    np.savetxt(pts, points, fmt="%.17g")
+    out = tmp_path / "sides.txt"
+    cli("inside", obj, pts, "-o", out)
+    codes = {"outside": bsprt.OUTSIDE, "inside": bsprt.INSIDE, "surface": bsprt.SURFACE}
+    want = np.array([codes[w] for w in out.read_text().split()], dtype=np.uint8)
+    got = q.sides(points)
+    assert got.dtype == np.uint8 and np.array_equal(got, want)
+    assert (want == bsprt.INSIDE).sum() > 20 and (want == bsprt.OUTSIDE).sum() > 1000
+    assert (want == bsprt.SURFACE).sum() > 0
+    assert np.array_equal(q.sides(points, threads=1), want)
+    assert np.array_equal(q.contains(points), want != bsprt.OUTSIDE)
+    # all hits: the CLI's CSV rows, t bit for bit
+    rays_path = _vertex_rays(tmp_path, obj)
+    csv = tmp_path / "all.csv"
+    cli("trace", obj, rays_path, "--all-hits", "-o", csv)
+    rows = np.loadtxt(csv, delimiter=",", skiprows=1, dtype=np.float64, ndmin=2)
+    c = q.all_hits_rays(bsprt.read_rays(rays_path))
+    assert len(c.ray) == rows.shape[0] > 1000
+    assert np.array_equal(c.ray, rows[:, 0].astype(np.int64))
+    assert np.array_equal(c.prim, rows[:, 1].astype(np.uint32))
+    assert np.array_equal(c.t, rows[:, 2].astype(np.float32))
+    assert np.array_equal(c.side, rows[:, 3].astype(np.int8))
+    again = q.all_hits(rays[:, 0:3], rays[:, 4:7], rays[:, 3], rays[:, 7])
+    assert np.array_equal(again.t, c.t) and np.array_equal(again.prim, c.prim)
+    # bad input: ValueError, never a crash
+    with pytest.raises(ValueError, match="point 1 has a NaN"):
+        q.sides([[0, 0, 0], [0, np.nan, 0]])
+    with pytest.raises(ValueError, match="shape"):
+        q.sides(np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="dtype"):
+        q.sides(np.zeros((4, 3), dtype=bool))
+    with pytest.raises(ValueError, match="overflows float32"):
+        q.sides([[1e300, 0, 0]])
+    with pytest.raises(TypeError):
+        q.all_hits_rays([[0] * 8])
+    with pytest.raises(ValueError):
+        q.all_hits_rays(np.zeros((3, 7), dtype=np.float32))
+
+
+def _vertex_rays(tmp_path, obj):
+    path = tmp_path / "vertex.rays"
+    if not path.exists():
+        cli("gen-rays", obj, "--kind", "vertex", "-n", "1500", "--seed", "3", "-o", path)
+    return path
