@@ -16,6 +16,7 @@
 #include "traverse/brute_force.h"
 #include "traverse/simd/cpu_features.h"
 #include "traverse/watertight.h"
+#include "traverse/simd/watertight_packet.h"
 #include "traverse/simd/watertight_packet_brute.h"
 
 using namespace bsprt;
@@ -388,4 +389,52 @@ TEST_CASE("watertight: batch widths are checked", "[watertight][packet]") {
     brute_force_trace_batch(soup, rays, hits, w, nullptr);
     for (const Hit& h : hits) CHECK(h.t == 1.0f);  // the face x + y + z = 4
   }
+}
+
+namespace {
+
+/// edges_double_lanes<W> against watertight_edges_double lane by lane, bits
+/// compared: random floats of all magnitudes (subnormal to near overflow),
+/// small integers whose products cancel exactly, and lanes left alone.
+template <int W>
+void check_vector_double_fallback(std::mt19937& g) {
+  using simd::vfloat;
+  using simd::vmask;
+  std::uniform_int_distribution<int> kind(0, 3), small(-4, 4), expo(-150, 126), coin(0, 1);
+  const auto value = [&](int k) -> float {
+    if (k == 0) return float(small(g));                                        // exact zeros and cancellations
+    if (k == 1) return std::ldexp(rand_in(g, -1, 1), expo(g));                 // any magnitude
+    if (k == 2) return rand_in(g, -1, 1) * 0x1p-140f;                          // subnormal
+    return rand_in(g, -1, 1);
+  };
+  std::size_t zeros = 0;
+  for (int round = 0; round < 2000; ++round) {
+    vfloat<W> in[6], u, v, w;
+    vmask<W> need{};
+    for (int i = 0; i < W; ++i) {
+      const int k = kind(g);
+      for (auto& x : in) x[i] = value(k);
+      u[i] = rand_in(g, -1, 1), v[i] = rand_in(g, -1, 1), w[i] = rand_in(g, -1, 1);
+      need[i] = coin(g) ? -1 : 0;
+    }
+    vfloat<W> gu = u, gv = v, gw = w;
+    simd::watertight_detail::edges_double_lanes<W>(need, in[0], in[1], in[2], in[3], in[4], in[5], gu, gv, gw);
+    for (int i = 0; i < W; ++i) {
+      float eu = u[i], ev = v[i], ew = w[i];
+      if (need[i]) watertight_edges_double(in[0][i], in[1][i], in[2][i], in[3][i], in[4][i], in[5][i], eu, ev, ew);
+      const float got[3] = {gu[i], gv[i], gw[i]}, want[3] = {eu, ev, ew};
+      REQUIRE(std::memcmp(got, want, sizeof got) == 0);
+      zeros += need[i] && (eu == 0.0f || ev == 0.0f || ew == 0.0f);
+    }
+  }
+  CHECK(zeros > 100);  // exact zeros were among the cases
+}
+
+}  // namespace
+
+TEST_CASE("watertight: the vector double fallback equals the scalar one", "[watertight]") {
+  std::mt19937 g(7);
+  check_vector_double_fallback<4>(g);
+  check_vector_double_fallback<8>(g);
+  check_vector_double_fallback<16>(g);
 }

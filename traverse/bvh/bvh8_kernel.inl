@@ -33,6 +33,7 @@
 #include "traverse/exact_double_stage.h"
 #include "traverse/exact_prefilter.h"
 #include "traverse/simd/simd.h"
+#include "traverse/simd/watertight_packet.h"
 #include "traverse/watertight.h"
 
 #if !defined(BSPRT_BVH8_ENTRY) || !defined(BSPRT_BVH8_OCCLUDED) || !defined(BSPRT_BVH8_BATCH)
@@ -176,14 +177,7 @@ inline void intersect_leaf(const WatertightRay& r, const float* rows, std::uint3
   V4 w = no_fma(bx * ay) - no_fma(by * ax);
   const M4 live = simd::VecTypes<4>::I{0, 1, 2, 3} < std::int32_t(count);
   const M4 zero = ((u == 0.0f) | (v == 0.0f) | (w == 0.0f)) & live;
-  if (simd::any<4>(zero)) {
-    for (int i = 0; i < 4; ++i) {
-      if (!zero[i]) continue;
-      float ui, vi, wi;
-      watertight_edges_double(ax[i], ay[i], bx[i], by[i], cx[i], cy[i], ui, vi, wi);
-      u[i] = ui, v[i] = vi, w[i] = wi;
-    }
-  }
+  if (simd::any<4>(zero)) simd::watertight_detail::edges_double_lanes<4>(zero, ax, ay, bx, by, cx, cy, u, v, w);
   const M4 neg = (u < 0.0f) | (v < 0.0f) | (w < 0.0f), pos = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
   // A leaf the ray passes beside (every live lane with edge functions of both
   // signs) ends here, before the determinant and the division, as Embree's

@@ -160,19 +160,26 @@ inline vfloat<W> pick_axis(const vfloat<W> (&a)[3], vmask<W> is0, vmask<W> is1) 
   return is0 ? a[0] : (is1 ? a[1] : a[2]);
 }
 
-/// Lanes of `need` get the double-precision edge functions (scalar fallback).
+/// Lanes of `need` get the double-precision edge functions of
+/// watertight_edges_double, computed for all W lanes at once in double
+/// vectors: the products of floats are exact in double and each difference is
+/// rounded to double, then to float, as the scalar function does, so every
+/// lane is the scalar fallback's bit for bit (a loop over the lanes, with an
+/// extract and a branch per lane, made bunny vertex rays of `bvh8-float` about
+/// 5 % slower; docs/notes/2026-12-07-mesh-query-and-kd-step-bound.md). Test:
+/// "watertight: the vector double fallback equals the scalar one".
 template <int W>
 inline void edges_double_lanes(vmask<W> need, const vfloat<W>& ax, const vfloat<W>& ay,
                                const vfloat<W>& bx, const vfloat<W>& by, const vfloat<W>& cx,
                                const vfloat<W>& cy, vfloat<W>& u, vfloat<W>& v, vfloat<W>& w) {
-  unsigned bits = movemask<W>(need);
-  while (bits != 0) {
-    const int i = __builtin_ctz(bits);
-    bits &= bits - 1;
-    float ui, vi, wi;
-    watertight_edges_double(ax[i], ay[i], bx[i], by[i], cx[i], cy[i], ui, vi, wi);
-    u[i] = ui, v[i] = vi, w[i] = wi;
-  }
+  using D = vdouble<W>;  // converted in place: no function returns a vector (the base ISA's ABI)
+  const D dax = __builtin_convertvector(ax, D), day = __builtin_convertvector(ay, D);
+  const D dbx = __builtin_convertvector(bx, D), dby = __builtin_convertvector(by, D);
+  const D dcx = __builtin_convertvector(cx, D), dcy = __builtin_convertvector(cy, D);
+  const vfloat<W> ud = __builtin_convertvector(dcx * dby - dcy * dbx, vfloat<W>);
+  const vfloat<W> vd = __builtin_convertvector(dax * dcy - day * dcx, vfloat<W>);
+  const vfloat<W> wd = __builtin_convertvector(dbx * day - dby * dax, vfloat<W>);
+  u = need ? ud : u, v = need ? vd : v, w = need ? wd : w;
 }
 }  // namespace watertight_detail
 
