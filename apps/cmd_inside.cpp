@@ -1,6 +1,9 @@
 // `bsprt inside SCENE POINTS -o OUT`: inside, outside or on the surface of a
 // closed mesh, for each point of a text file, exactly (robust/inside_query.h).
 #include <fmt/core.h>
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <charconv>
@@ -16,6 +19,7 @@
 #include "apps/cli_common.h"
 #include "apps/progress.h"
 #include "bsprt/error.h"
+#include "geometry/core/fp_env.h"
 #include "geometry/core/read_file.h"
 #include "robust/inside_query.h"
 
@@ -25,6 +29,7 @@ namespace {
 struct InsideArgs {
   std::string scene, points, output;
   bool allow_nonfinite = false;
+  int threads = 0;
 };
 
 /// The points of a points file, and how many of them were rounded.
@@ -104,17 +109,21 @@ void run(const InsideArgs& a) {
                "warning: {} edges of the mesh are open, non-manifold or inconsistently oriented: inside and "
                "outside by parity are not well defined there\n",
                bad);
+  const auto cap = limit_threads(a.threads);
   const auto t0 = std::chrono::steady_clock::now();
   const InsideQuery query(soup);
   std::vector<PointSide> sides(points.size());
-  RayCounters c;
+  tbb::combinable<RayCounters> counters;
   ProgressBar bar("inside", points.size(), "points", ProgressBar::stderr_is_terminal() && points.size() > 10000);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    sides[i] = query.side(points[i], &c);
-    if ((i & 1023) == 1023) bar.advance(1024);
-  }
+  IeeeTasks ieee;  // IEEE arithmetic in every task (geometry/core/fp_env.h)
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024), [&](const auto& r) {
+    RayCounters& c = counters.local();
+    for (std::size_t i = r.begin(); i < r.end(); ++i) sides[i] = query.side(points[i], &c);
+    bar.advance(r.size());
+  }, ieee.context());
   bar.set(points.size());
   bar.finish();
+  const RayCounters c = counters.combine([](RayCounters x, const RayCounters& y) { return x += y; });
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ofstream out(a.output);
   if (!out) throw InputError(a.output, "cannot write");
@@ -147,6 +156,8 @@ void register_inside(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", args->output, "text file: inside, outside or surface, a line per point")->required()->check(output_file());
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");
+  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores); the answers do not depend on it")
+      ->check(integer_in(0, kMaxThreads));
   cmd->callback([args] { run(*args); });
 }
 

@@ -404,6 +404,11 @@ TEST_CASE("api: MeshQuery answers what bsprt inside and trace --all-hits write",
     CHECK(got == want);
   }
   for (std::size_t i = 0; i < points.size(); i += 97) CHECK(query.side(points[i]) == want[i]);
+  for (const char* threads : {"1", "2"}) {  // the CLI's own threads give the same file
+    const std::string again = test::temp_path(std::string("api-torus.sides.") + threads);
+    REQUIRE(test::bsprt_cli("inside " + obj + " " + pts + " -o " + again + " --threads " + threads).status == 0);
+    CHECK(file_bytes(again) == file_bytes(out));
+  }
 
   // All hits: the rows of the CLI's CSV, t bit for bit.
   const std::string rays = test::temp_path("api-torus.rays"), csv = test::temp_path("api-torus.csv");
