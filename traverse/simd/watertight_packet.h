@@ -166,7 +166,7 @@ inline vfloat<W> pick_axis(const vfloat<W> (&a)[3], vmask<W> is0, vmask<W> is1) 
 /// rounded to double, then to float, as the scalar function does, so every
 /// lane is the scalar fallback's bit for bit (a loop over the lanes, with an
 /// extract and a branch per lane, made bunny vertex rays of `bvh8-float` about
-/// 5 % slower; docs/notes/2026-12-07-mesh-query-and-kd-step-bound.md). Test:
+/// 4 % slower; docs/notes/2026-12-07-mesh-query-and-kd-step-bound.md). Test:
 /// "watertight: the vector double fallback equals the scalar one".
 template <int W>
 inline void edges_double_lanes(vmask<W> need, const vfloat<W>& ax, const vfloat<W>& ay,
