@@ -50,15 +50,22 @@ struct TriangleHit {
 
 inline namespace BSPRT_ISA_NAMESPACE {
 
-/// Precomputes the shear of `ray` (paper Fig. 1, lines 1-12). Invalid rays get
-/// valid = false and then miss every triangle.
-inline WatertightRay watertight_precompute(const Ray& ray) {
-  WatertightRay r;
+/// Precomputes the shear of `ray` (paper Fig. 1, lines 1-12) into `r`, field
+/// by field. Invalid rays get valid = false and then miss every triangle.
+/// Kernels that make the shear lazily, into a WatertightRay declared before
+/// (the BVH8's first leaf, the BSP's per-ray leaf constants), call this rather
+/// than assigning watertight_precompute's result: GCC built that result on the
+/// stack and copied it with loads wider than the stores that made it, which
+/// cannot be forwarded (perf, `bvh8` on sponza's atrium camera rays: 3 % of
+/// the samples on that copy).
+inline void watertight_init(const Ray& ray, WatertightRay& r) {
   r.org = ray.org;
   r.tnear = ray.tnear;
   r.tfar = ray.tfar;
   r.valid = is_valid(ray);
-  if (!r.valid) return r;
+  r.kx = 0, r.ky = 1, r.kz = 2;
+  r.sx = 0.0f, r.sy = 0.0f, r.sz = 1.0f;
+  if (!r.valid) return;
   r.kz = max_axis(ray.dir);
   r.kx = r.kz == 2 ? 0 : r.kz + 1;
   r.ky = r.kx == 2 ? 0 : r.kx + 1;
@@ -66,6 +73,12 @@ inline WatertightRay watertight_precompute(const Ray& ray) {
   r.sx = ray.dir[r.kx] / ray.dir[r.kz];
   r.sy = ray.dir[r.ky] / ray.dir[r.kz];
   r.sz = 1.0f / ray.dir[r.kz];
+}
+
+/// The same, returned.
+inline WatertightRay watertight_precompute(const Ray& ray) {
+  WatertightRay r;
+  watertight_init(ray, r);
   return r;
 }
 

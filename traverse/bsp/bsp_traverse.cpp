@@ -43,7 +43,7 @@ inline void leaf_ray_setup(const BspView& v, const Ray& ray, LeafRay& lr) {
   if (v.exact_leaf)
     detail::exact_ray_init(ray, lr.er);
   else
-    lr.wr = watertight_precompute(ray);
+    watertight_init(ray, lr.wr);
 }
 
 /// Tests the triangles of a leaf (ties keep the earlier triangle). With an

@@ -294,7 +294,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
       if constexpr (kCount) ++c->leaf_visits;
       if (v.exact_leaf) {
         // Triangles the float filter proves missed never reach the exact test.
-        if (!sheared) wr = watertight_precompute(ray), sheared = true, filter = filterable(wr, ray);
+        if (!sheared) watertight_init(ray, wr), sheared = true, filter = filterable(wr, ray);
         const float* rows = v.leaf_soa + Bvh8Tree::kSoaFloats * std::size_t(first);
         const unsigned all = (1u << count) - 1u;
         const unsigned lanes = filter ? exact_lanes(wr, rows, count) : all;
@@ -335,7 +335,7 @@ Hit trace_kernel(const Bvh8View& v, const Ray& ray, RayCounters* c) {
         tfar = cull < tfar ? cull : tfar;
       } else {
         if constexpr (kCount) c->triangle_tests += count;
-        if (!sheared) wr = watertight_precompute(ray), sheared = true;
+        if (!sheared) watertight_init(ray, wr), sheared = true;
         intersect_leaf(wr, v.leaf_soa + Bvh8Tree::kSoaFloats * std::size_t(first), count, hit);
         if (kAnyHit && hit.hit()) return hit;
         tfar = hit.t < tfar ? hit.t : tfar;
