@@ -203,6 +203,9 @@ void register_build(CLI::App& app) {
                   "bsp: --min-gain limits every split of a node of at most this many triangles, in larger nodes only "
                   "splits that keep all of them in one child (docs/bsp-build.md)")
       ->capture_default_str()->check(integer_in(0, 1 << 30));
+  cmd->add_flag("--planar-slabs,!--no-planar-slabs", args->costs.planar_slabs,
+                "bsp: kd candidates one float step either side of each axis-planar triangle, so a split can keep it "
+                "in a thin slab (default on; docs/bsp-build.md)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")
       ->check(integer_in(0, kMaxThreads))->capture_default_str();
   cmd->add_flag("--allow-nonfinite", args->allow_nonfinite, "keep triangles with NaN/Inf corners (flagged degenerate)");

@@ -825,6 +825,60 @@ TEST_CASE("BSP: a direction scaled out of range by a power of two is traced at n
   CHECK(c.ok());
 }
 
+TEST_CASE("bsp: floors and walls on their cells' boundaries are kept in thin slabs (regression: "
+          "stiff_two-boxes random rays, 4.76 triangle tests a ray against the kd-tree's 1.39)",
+          "[bsp]") {
+  // A closed room 10 x 4 x 10, each wall a grid of quads. After the split through
+  // a wall's own plane the wall lies on its cell's boundary, where no kd candidate
+  // at a triangle's bounds lies strictly inside the cell on that axis: without the
+  // slab candidates (BspConfig::planar_slabs) every random ray that crosses such a
+  // cell tests the wall's triangles in it, however far from the wall it passes.
+  TriangleSoup room;
+  const int q = 6;
+  const auto quad = [&](Vec3f o, Vec3f u, Vec3f v) {
+    for (int i = 0; i < q; ++i)
+      for (int j = 0; j < q; ++j) {
+        const Vec3f a = o + u * (float(i) / q) + v * (float(j) / q), b = a + u * (1.0f / q), c = a + v * (1.0f / q);
+        const Vec3f d = b + v * (1.0f / q);
+        const std::uint32_t k = std::uint32_t(room.vertices.size());
+        room.vertices.insert(room.vertices.end(), {a, b, d, c});
+        room.triangles.push_back({k, k + 1, k + 2});
+        room.triangles.push_back({k, k + 2, k + 3});
+      }
+  };
+  const Vec3f x{10, 0, 0}, y{0, 4, 0}, z{0, 0, 10};
+  quad({0, 0, 0}, x, z);  // floor
+  quad(y, z, x);          // ceiling
+  quad({0, 0, 0}, z, y);  // the four walls
+  quad(x, y, z);
+  quad({0, 0, 0}, y, x);
+  quad(z, x, y);
+  BspConfig with, without;
+  with.threads = without.threads = 1;
+  without.planar_slabs = false;
+  REQUIRE(with.planar_slabs);  // the default
+  const BspScene a = build_bsp_scene(room, with), b = build_bsp_scene(room, without);
+  REQUIRE_NOTHROW(a.exact.validate(a.soup.size(), &a.soup));
+  REQUIRE_NOTHROW(a.flat.validate());
+  const BspTracer slabs(a.flat, a.soup), none(b.flat, b.soup);
+  const std::vector<Ray> rays = make_rays(RaySetKind::Random, a.soup, 20000, 7);
+  std::vector<Hit> ha(rays.size()), hb(rays.size());
+  RayCounters ca, cb;
+  slabs.trace_batch(rays, ha, 1, &ca);
+  none.trace_batch(rays, hb, 1, &cb);
+  const double n = double(rays.size());
+  INFO("triangle tests a random ray: " << double(ca.triangle_tests) / n << " with slabs, "
+                                        << double(cb.triangle_tests) / n << " without");
+  CHECK(double(ca.triangle_tests) <= 0.5 * double(cb.triangle_tests));
+  for (const BspTracer* t : {&slabs, &none}) {
+    const Comparison c = compare_with_brute(a.soup, *t, rays);
+    INFO((t == &slabs ? "with slabs" : "without") << ": lost " << c.lost << ", farther " << c.farther
+                                                   << "; first: " << c.first_failure);
+    CHECK(c.ok());
+    CHECK(c.hits > rays.size() / 2);
+  }
+}
+
 TEST_CASE("BSP flat sections round-trip through a tree file", "[bsp]") {
   const BspScene s = build_bsp_scene(load_mesh(scene_path("suzanne.obj")));
   const std::string path = temp_path("suzanne_flat.bsp");

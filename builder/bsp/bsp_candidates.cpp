@@ -23,6 +23,16 @@ float float_up(double x) {
   return f;
 }
 
+/// One side of the slab around an axis-planar triangle at c (BspConfig::
+/// planar_slabs): one float step from c, or 2^-60 when |c| < 2^-60, so that no
+/// split lies at a subnormal position (the kd-tree builder skips its offset
+/// planes there for the same reason: a watertight test's products underflow).
+float slab_side(float c, int dir) {
+  constexpr float kInf = std::numeric_limits<float>::infinity(), kNear0 = 0x1p-60f;
+  if (std::abs(c) < kNear0) return dir < 0 ? c - kNear0 : c + kNear0;
+  return std::nextafter(c, dir < 0 ? -kInf : kInf);
+}
+
 double box_area(const Box3d& b) {
   const Vec3d d = b.diagonal();
   return 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
@@ -59,7 +69,14 @@ void kd_axis(const NodeView& v, const BspConfig& cfg, int a, const std::vector<B
   for (std::size_t i = 0; i < n; ++i) {
     lo[i] = tb[i].lo[a];
     hi[i] = tb[i].hi[a];
-    if (lo[i] == hi[i]) flat.push_back(lo[i]);
+    if (lo[i] == hi[i]) {
+      flat.push_back(lo[i]);
+      if (cfg.planar_slabs) {  // a slab around it (BspConfig::planar_slabs)
+        const float c = float_down(lo[i]);
+        cand.push_back(slab_side(c, -1));
+        cand.push_back(slab_side(c, +1));
+      }
+    }
     cand.push_back(float_down(lo[i]));
     cand.push_back(float_up(hi[i]));
   }

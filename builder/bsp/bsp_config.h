@@ -61,6 +61,15 @@ struct BspConfig {
   /// node holds at least this many triangles; below it, a flat sphere list.
   std::size_t bsh_min_triangles = 32;
   bool kd_candidates = true;    ///< axis-aligned planes at the clipped triangles' bounds
+  /// With kd_candidates: for a triangle in an axis plane x_a = c, also the
+  /// planes one float step either side of c (2^-60 when |c| < 2^-60), so that
+  /// a split can keep the triangle in a thin slab and leave the space beside
+  /// it empty. Without them a floor or a wall that lies on its cell's boundary
+  /// (after the split through its own plane) stays listed in a cell of any
+  /// depth: no other candidate lies strictly inside that cell on that axis.
+  /// The kd-tree builder tries the planes one step either side of every event
+  /// (kd_events.cpp). docs/bsp-build.md, "Slabs around axis-planar triangles".
+  bool planar_slabs = true;
   bool face_candidates = true;  ///< each triangle's face plane
   bool edge_candidates = true;  ///< the three planes through a triangle's edges, orthogonal to it
   BspMembership membership = BspMembership::Area;  ///< see BspMembership (Area: the paper's one-triangle leaves)
