@@ -115,8 +115,8 @@ void add_trace_options(CLI::App& cmd, TraceOptions& o, const std::string& defaul
                  "(default: 1024 for bsp-top, 1 for bsp-bvh8)")
       ->check(integer_in(1, 1 << 27));
   cmd.add_option("--single-rays", o.single_rays,
-                 "bsp, bsp-float, bsp-zero-eps: how single rays run: auto (interleaved for incoherent rays with tfar = inf), "
-                 "sequential or interleaved; the hits are the same")
+                 "bsp, bsp-float, bsp-zero-eps: how single rays run: auto (interleaved for incoherent rays with "
+                 "tfar = inf on trees of 32 KiB or more), sequential or interleaved; the hits are the same")
       ->check(CLI::IsMember({"auto", "sequential", "interleaved"}))
       ->capture_default_str();
   cmd.add_flag("--allow-nonfinite", o.allow_nonfinite,

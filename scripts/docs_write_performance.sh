@@ -69,7 +69,8 @@ Every number below is in the files of \`docs/perf/\` that the same run wrote.*
 Modes (\`--accel\` names): **kd** SAH kd-tree; **bsp** (the default) exact BSP, float traversal with certified
 epsilons, every leaf decision exact (double filter, rules on exact zeros, CGAL \`Mpzf\`; docs/exact-leaf-test.md);
 single rays run eight interleaved at a time when a block
-is incoherent and unbounded, not camera rays, docs/certified-epsilons.md §11; **bsp-float** the same with the
+is incoherent and unbounded (not camera rays) and the tree is 32 KiB or more (not the smallest scenes),
+docs/certified-epsilons.md §11; **bsp-float** the same with the
 watertight float triangle test; **bsp-top** the same tree under a 4-wide box top over
 subtrees of ≤ 1024 slots (single rays only, exact leaves; docs/certified-epsilons.md §10);
 **bsp-zero-eps** the same tree with all epsilons 0 and float leaves;

@@ -662,6 +662,39 @@ TEST_CASE("camera rays look coherent and random rays do not and shadow segments 
   CHECK_FALSE(rays_unbounded(std::span<const Ray>()));
 }
 
+TEST_CASE("automatic single rays: small trees run sequentially, larger ones interleaved", "[bsp]") {
+  // Incoherent unbounded rays interleave only when the tree outgrows the L1
+  // data cache (kInterleaveMinBytes): on the cube's 1.5 KB tree vertex-aimed
+  // rays ran 1.6x slower interleaved (docs/certified-epsilons.md §11).
+  const BspScene cube = build_bsp_scene(load_mesh(scene_path("cube.obj")));
+  const BspScene suzanne = build_bsp_scene(load_mesh(scene_path("suzanne.obj")));
+  BspTracer small(cube.flat, cube.soup), large(suzanne.flat, suzanne.soup);
+  REQUIRE(small.walk_bytes() < kInterleaveMinBytes);
+  REQUIRE(large.walk_bytes() >= kInterleaveMinBytes);
+  CHECK(small.walk_bytes() <= small.memory_bytes());
+  for (RaySetKind k : {RaySetKind::Random, RaySetKind::Vertex, RaySetKind::Edge}) {
+    const std::vector<Ray> rays = make_rays(k, suzanne.soup, 4096, 5);
+    const std::vector<Ray> cube_rays = make_rays(k, cube.soup, 4096, 5);
+    CHECK(large.interleaves(rays));
+    CHECK_FALSE(large.interleaves(rays, true));  // counted: sequential
+    CHECK_FALSE(small.interleaves(cube_rays));
+    small.set_single_rays(BspSingleRays::Interleaved);
+    CHECK(small.interleaves(cube_rays));  // forced, whatever the size
+    small.set_single_rays(BspSingleRays::Auto);
+    large.set_single_rays(BspSingleRays::Sequential);
+    CHECK_FALSE(large.interleaves(rays));
+    large.set_single_rays(BspSingleRays::Auto);
+  }
+  CHECK_FALSE(large.interleaves(make_rays(RaySetKind::Primary, suzanne.soup, 4096, 5)));  // coherent
+  // Same hits either way (the kernels' equality is tested above at every batch size).
+  const std::vector<Ray> rays = make_rays(RaySetKind::Vertex, cube.soup, 2000, 9);
+  std::vector<Hit> automatic(rays.size()), interleaved(rays.size());
+  small.trace_batch(rays, automatic, 1);
+  small.set_single_rays(BspSingleRays::Interleaved);
+  small.trace_batch(rays, interleaved, 1);
+  CHECK(std::memcmp(automatic.data(), interleaved.data(), rays.size() * sizeof(Hit)) == 0);
+}
+
 TEST_CASE("BSP rays from inside closed meshes never escape", "[bsp]") {
   for (const auto& [scale, shift] : {std::pair{1.0f, Vec3f{0, 0, 0}}, std::pair{1e-4f, Vec3f{0, 0, 0}},
                                      std::pair{1.0f, Vec3f{1e4f, -1e4f, 0}}}) {

@@ -598,10 +598,7 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   // Box tops trace single rays, and so do exact leaves when counted (the
   // packet kernels count no exact decisions; the counts are the same).
   const auto singles = [&](std::span<const Ray> r, std::span<Hit> h) {
-    const bool interleave = !counters && !has_top_ && !wide_ && !tree_.bounds.empty() &&
-                            (single_rays_ == BspSingleRays::Interleaved ||
-                             (single_rays_ == BspSingleRays::Auto && !rays_look_coherent(r) && rays_unbounded(r)));
-    if (interleave) {
+    if (interleaves(r, counters != nullptr)) {
       trace_interleaved(v, r.data(), r.size(), h.data());
       return;
     }
@@ -681,10 +678,20 @@ void BspTracer::set_box_top(BoxTop top) {
   has_top_ = true;
 }
 
+std::size_t BspTracer::walk_bytes() const {
+  return compact_.slots.size() * sizeof(CompactBspSlot) + tree_.prims.size() * sizeof(std::uint32_t) +
+         triangles_.size() * sizeof(BspTriangle);
+}
+
+bool BspTracer::interleaves(std::span<const Ray> rays, bool counted) const {
+  if (counted || has_top_ || wide_ || tree_.bounds.empty()) return false;
+  if (single_rays_ == BspSingleRays::Interleaved) return true;
+  return single_rays_ == BspSingleRays::Auto && walk_bytes() >= kInterleaveMinBytes && !rays_look_coherent(rays) &&
+         rays_unbounded(rays);
+}
+
 std::size_t BspTracer::memory_bytes() const {
-  return (wide_ ? wide_->memory_bytes() : 0) + top_.nodes.size() * sizeof(BoxTopNode) +
-         compact_.slots.size() * sizeof(CompactBspSlot) +
-         tree_.prims.size() * sizeof(std::uint32_t) + triangles_.size() * sizeof(BspTriangle);
+  return (wide_ ? wide_->memory_bytes() : 0) + top_.nodes.size() * sizeof(BoxTopNode) + walk_bytes();
 }
 
 }  // namespace bsprt

@@ -10,6 +10,7 @@
 /// rounding and widen, never trust a float comparison near the plane. Leaves
 /// use the watertight test (watertight.h).
 
+#include <cstddef>
 #include <memory>
 #include <span>
 #include <string>
@@ -40,9 +41,11 @@ enum class BspEpsilon {
 /// steps of trace() in the same order, so hits are the same bit for bit; only
 /// speed differs.
 enum class BspSingleRays {
-  /// Interleaved when the batch looks incoherent (not rays_look_coherent) and
-  /// its rays are unbounded (rays_unbounded); else sequential. Shadow rays
-  /// (short segments to a light) were slower interleaved
+  /// Interleaved when the batch looks incoherent (not rays_look_coherent),
+  /// its rays are unbounded (rays_unbounded) and the tree is too large to stay
+  /// in the L1 data cache (BspTracer::walk_bytes() >= kInterleaveMinBytes);
+  /// else sequential. Shadow rays (short segments to a light) were slower
+  /// interleaved, and so were the small scenes' trees, whose loads never wait
   /// (docs/certified-epsilons.md §11, docs/notes/2026-11-22-interleaved-single-rays.md).
   Auto,
   /// One ray after the other, the branchy loop of trace(): fastest on
@@ -53,6 +56,15 @@ enum class BspSingleRays {
   /// edge-aimed).
   Interleaved,
 };
+
+/// Smallest tree (BspTracer::walk_bytes) that BspSingleRays::Auto interleaves.
+/// Below it the nodes and leaf triangles stay in the L1 data cache (48 KiB on
+/// the AMD EPYC of docs/performance.md, 32 KiB on most x86 cores), so no load
+/// waits for the other rays to overlap, and the interleaved kernel's extra
+/// work per step is not repaid: on the shared scenes' trees of 0.3-7 KB
+/// vertex-aimed rays ran 1.4-2.2x slower interleaved, while trees of 59 KB and
+/// more ran 4-33 % faster (docs/notes/2026-12-08-small-trees-sequential.md).
+inline constexpr std::size_t kInterleaveMinBytes = 32 * 1024;
 
 /// Whether a batch looks coherent, like camera rays in tiles: at least half of
 /// up to 16 evenly spaced pairs of neighbouring rays have directions within
@@ -169,6 +181,13 @@ class BspTracer final : public Accelerator {
   const BoxTop& box_top() const { return top_; }
   /// Nodes, leaf lists, the copied triangles and the box top.
   std::size_t memory_bytes() const override;
+  /// What a walk without a top reads: the compact nodes and the leaves'
+  /// triangle numbers and corners.
+  std::size_t walk_bytes() const;
+  /// Whether trace_batch runs these single rays interleaved (set_single_rays;
+  /// Auto: see BspSingleRays::Auto). Counted batches, box tops and BVH8 tops
+  /// always run sequentially.
+  bool interleaves(std::span<const Ray> rays, bool counted = false) const;
 
   BspEpsilon mode() const { return mode_; }
   /// The traversal layout made from the tree (bsp_compact.h).
