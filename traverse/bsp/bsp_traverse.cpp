@@ -554,12 +554,26 @@ bool rays_look_coherent(std::span<const Ray> rays) {
 }
 
 bool packet_looks_coherent(std::span<const Ray> rays) {
-  const Vec3f* first = nullptr;
+  // directions_close(first, d) for each valid lane d, its operations in its
+  // order (so the same answer), with the first lane's terms made once and each
+  // lane's squared length shared with its validity test. Run for every
+  // packet: 48 instructions a ray on sponza's camera packets before, 35 now
+  // (cachegrind). Two lanes per SSE2 vector measured 37: packing the
+  // lanes' directions costs what the vector saves.
+  Vec3d first;
+  double first98 = 0.0;
+  bool have = false;
   for (const Ray& r : rays) {
-    const double len2 = dot(Vec3d(r.dir), Vec3d(r.dir));
-    if (!(len2 > 0.0) || !std::isfinite(len2)) continue;  // an invalid lane: it traces nothing
-    if (!first) first = &r.dir;
-    else if (!directions_close(*first, r.dir)) return false;
+    const Vec3d d(r.dir);
+    const double len2 = dot(d, d);
+    // An invalid lane (zero, NaN or infinite direction) traces nothing.
+    if (!(len2 > 0.0 && len2 < std::numeric_limits<double>::infinity())) continue;
+    if (!have) {
+      first = d, first98 = 0.98 * len2, have = true;
+      continue;
+    }
+    const double ab = dot(first, d);
+    if (!(ab > 0.0 && ab * ab > first98 * len2)) return false;
   }
   return true;
 }
