@@ -6,9 +6,17 @@
 /// as a template (pbrt's KdTreeAggregate::Intersect loop). Inlined: the
 /// kernels compile to the code they had with their own copies.
 
+#include <bit>
 #include <cstdint>
 
 namespace bsprt::detail {
+
+/// a where mask is all ones, b where it is 0, by bits: GCC compiles a float
+/// ?: to a branch, which mispredicts where the choice follows the ray
+/// (direction signs of random rays, the lanes of the interleaved kernel).
+[[gnu::always_inline]] inline float select_bits(std::uint32_t mask, float a, float b) {
+  return std::bit_cast<float>((std::bit_cast<std::uint32_t>(a) & mask) | (std::bit_cast<std::uint32_t>(b) & ~mask));
+}
 
 /// A deferred far child and the ray interval it is entered with.
 struct StackEntry {

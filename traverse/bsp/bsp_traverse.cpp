@@ -371,11 +371,7 @@ inline bool wide_takes(const Ray& ray) {
 constexpr unsigned kFirstBit = unsigned(std::countr_zero(CompactBspSlot::kFirstEmpty));
 static_assert(CompactBspSlot::kSecondEmpty == CompactBspSlot::kFirstEmpty << 1);
 
-/// a where mask is all ones, b where it is 0, by bits: GCC compiles a float
-/// ?: to a branch.
-inline float select_bits(std::uint32_t mask, float a, float b) {
-  return std::bit_cast<float>((std::bit_cast<std::uint32_t>(a) & mask) | (std::bit_cast<std::uint32_t>(b) & ~mask));
-}
+using detail::select_bits;
 
 /// One ray's state in the interleaved kernel: traverse_subtree's locals, kept
 /// between steps.
