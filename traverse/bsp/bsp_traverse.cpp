@@ -380,7 +380,7 @@ struct Lane {
   LeafRay lr;  ///< made at the ray's first leaf (lr_ready): most random rays reach none
   bool lr_ready;
   Hit hit;
-  NearestHit nearest;  ///< exact leaf tests only
+  NearestHit nearest;  ///< exact leaf tests only; only .hit is set before the ray's first leaf
   const Ray* ray;
   std::size_t index;  ///< slot in hits; kIdle: no ray left for this lane
   std::uint32_t node;
@@ -421,7 +421,7 @@ inline bool lane_step(const BspView& v, Lane& L) {
     return false;
   }
   if (L.pop == 0) {
-    if (!L.lr_ready) leaf_ray_setup(v, *L.ray, L.lr), L.lr_ready = true;
+    if (!L.lr_ready) leaf_ray_setup(v, *L.ray, L.lr), L.nearest = NearestHit{}, L.lr_ready = true;
     intersect_leaf<false>(v, *n, *L.ray, L.lr, L.hit, L.nearest, nullptr);
   }
   const float best = detail::hit_bound(L.rc, L.hit.t);
@@ -457,7 +457,7 @@ void trace_interleaved(const BspView& v, const Ray* rays, std::size_t count, Hit
       }
       L.lr_ready = false;
       L.hit = Hit{};
-      L.nearest = NearestHit{};
+      L.nearest.hit = Hit{};  // the rest at the ray's first leaf (lr_ready): most random rays reach none
       L.ray = &rays[i];
       L.index = i;
       L.node = 0;
