@@ -34,26 +34,32 @@ using detail::StackEntry;
 
 /// Per-ray constants of the leaf test: the watertight shear for float
 /// leaves, the double filter's for exact ones (exact_double_stage.h). Only
-/// the one the tracer uses is made, once per ray.
+/// the one the tracer uses is made, once per ray, at the ray's first leaf
+/// (`ready`): a random ray reaches 0.4 leaves on average (bunny), and the
+/// exact constants cost two divisions and a branchy choice of axes.
 struct LeafRay {
   WatertightRay wr;
   detail::ExactRayConst er;
+  bool ready = false;
 };
 inline void leaf_ray_setup(const BspView& v, const Ray& ray, LeafRay& lr) {
   if (v.exact_leaf)
     detail::exact_ray_init(ray, lr.er);
   else
     watertight_init(ray, lr.wr);
+  lr.ready = true;
 }
 
 /// Tests the triangles of a leaf (ties keep the earlier triangle). With an
 /// exact leaf test, `nearest` keeps the exact order and the answer; hit then
 /// holds its prim and, as t, the cull bound (cull_bound).
 template <bool kCount, bool kAnyHit = false>
-inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray& ray, const LeafRay& lr,
+inline void intersect_leaf(const BspView& v, const CompactBspSlot& n, const Ray& ray, LeafRay& lr,
                            Hit& hit, NearestHit& nearest, RayCounters* c) {
   const std::uint32_t first = n.prim_offset(), end = first + n.prim_count();
   if constexpr (kCount) ++c->leaf_visits;
+  if (!lr.ready) [[unlikely]]
+    leaf_ray_setup(v, ray, lr);
   if (v.exact_leaf) {
     detail::exact_leaf_staged<kAnyHit>(*v.exact_leaf, ray, lr.er, v.prims + first, v.triangles + first,
                                        n.prim_count(), nearest, kCount ? c : nullptr);
@@ -94,7 +100,7 @@ inline bool cut_node(const CompactBspSlot* n, const BspRayConst& rc, float& near
 /// triangle (not stored, bsp_compact.h); a popped cell is skipped when it
 /// starts past the nearest hit. bsp_packet.inl repeats these steps.
 template <bool kCount, bool kAnyHit = false, detail::Order kOrder = detail::Order::Ordered>
-inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray& ray, const LeafRay& lr,
+inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray& ray, LeafRay& lr,
                              std::uint32_t root, float tmin, float tmax, Hit& hit, NearestHit& nearest,
                              RayCounters* c) {
   StackEntry stack[kBspMaxDepth];
@@ -169,8 +175,7 @@ inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& wa
   if constexpr (kCount) ++c->rays;
   const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
   if (!rc.live) return hit;
-  LeafRay lr;
-  leaf_ray_setup(v, ray, lr);
+  LeafRay lr;  // made at the first leaf
   NearestHit nearest;
   if constexpr (kCount) {
     const std::uint64_t before = c->exact_decisions;  // set by an exact leaf test
@@ -186,7 +191,7 @@ inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& wa
 /// (occluded), whose hit is some hit in [tnear, tfar], not necessarily the nearest.
 template <bool kCount, bool kAnyHit = false>
 Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
-  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const LeafRay& lr, Hit& hit,
+  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, LeafRay& lr, Hit& hit,
                                           NearestHit& nearest) {
     // A segment that starts at t >= 0 (camera and secondary rays) widens
     // without max and min (detail::Order); the packet kernels choose alike.
@@ -205,7 +210,7 @@ Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
 /// the certified steps from its root.
 template <bool kCount>
 inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayConst& rc, const Ray& ray,
-                     const LeafRay& lr, Hit& hit, NearestHit& nearest, RayCounters* c) {
+                     LeafRay& lr, Hit& hit, NearestHit& nearest, RayCounters* c) {
   using V = simd::vfloat<4>;
   struct Entry {
     std::uint32_t ref;
@@ -294,7 +299,7 @@ inline void walk_top(const BspView& v, const BoxTopNode* nodes, const BspRayCons
 /// One ray through the box top and the subtrees under it.
 template <bool kCount>
 Hit trace_top(const BspView& v, const BoxTopNode* nodes, const Ray& ray, RayCounters* c) {
-  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, const LeafRay& lr, Hit& hit,
+  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, LeafRay& lr, Hit& hit,
                                           NearestHit& nearest) {
     walk_top<kCount>(v, nodes, rc, ray, lr, hit, nearest, c);
   });
@@ -311,9 +316,8 @@ struct WideRay {
   const Ray* ray;
   const Bvh8Subtree* subtrees;
   bool set_up = false;
-  bool leaf_set_up = false;  ///< lr made
   BspRayConst rc;    ///< made at the first subtree the ray enters
-  LeafRay lr;        ///< made at the first subtree the ray enters
+  LeafRay lr;        ///< made at the first leaf the ray reaches (intersect_leaf)
 };
 
 /// Subtree `index` under the BVH8 top: the ray's interval clipped to the
@@ -345,7 +349,6 @@ void wide_subtree(WideRay& w, std::uint32_t index, Hit& hit, NearestHit& nearest
   float tmax = exit < rc.tmax ? exit : rc.tmax;
   tmax = tmax < best ? tmax : best;
   if (!(tmin <= tmax)) return;
-  if (!w.leaf_set_up) leaf_ray_setup(*w.v, *w.ray, w.lr), w.leaf_set_up = true;
   traverse_subtree<kCount>(*w.v, rc, *w.ray, w.lr, w.subtrees[index].slot, tmin, tmax, h, nearest, c);
 }
 
@@ -377,8 +380,7 @@ using detail::select_bits;
 /// between steps.
 struct Lane {
   BspRayConst rc;
-  LeafRay lr;  ///< made at the ray's first leaf (lr_ready): most random rays reach none
-  bool lr_ready;
+  LeafRay lr;  ///< made at the ray's first leaf: most random rays reach none
   Hit hit;
   NearestHit nearest;  ///< exact leaf tests only; only .hit is set before the ray's first leaf
   const Ray* ray;
@@ -421,7 +423,7 @@ inline bool lane_step(const BspView& v, Lane& L) {
     return false;
   }
   if (L.pop == 0) {
-    if (!L.lr_ready) leaf_ray_setup(v, *L.ray, L.lr), L.nearest = NearestHit{}, L.lr_ready = true;
+    if (!L.lr.ready) L.nearest = NearestHit{};  // intersect_leaf makes L.lr
     intersect_leaf<false>(v, *n, *L.ray, L.lr, L.hit, L.nearest, nullptr);
   }
   const float best = detail::hit_bound(L.rc, L.hit.t);
@@ -455,9 +457,9 @@ void trace_interleaved(const BspView& v, const Ray* rays, std::size_t count, Hit
         hits[i] = Hit{};
         continue;
       }
-      L.lr_ready = false;
+      L.lr.ready = false;
       L.hit = Hit{};
-      L.nearest.hit = Hit{};  // the rest at the ray's first leaf (lr_ready): most random rays reach none
+      L.nearest.hit = Hit{};  // the rest at the ray's first leaf (lr.ready): most random rays reach none
       L.ray = &rays[i];
       L.index = i;
       L.node = 0;
