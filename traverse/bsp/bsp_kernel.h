@@ -175,10 +175,12 @@ inline F plane_cut(const CompactBspSlot* n, const F (&o)[3], const F (&dir)[3], 
   const F inv = 1.0f / b;
   const F q_first = (e - a) * inv, q_second = (-e - a) * inv;
   const auto flip = b < 0.0f;
-  if constexpr (std::is_same_v<F, float>) {
-    // flip ? q_second : q_first by mask: as a ?: GCC branches on the slope's
-    // sign, which the interleaved kernel's lanes mispredict (1.4 a random
-    // bunny ray, cachegrind).
+  if constexpr (std::is_same_v<F, float> && kOrder == Order::PerLane) {
+    // The interleaved kernel (PerLane on one ray): flip ? q_second : q_first
+    // by mask. As a ?: GCC branches on the slope's sign, which the kernel's
+    // lanes in round robin mispredict (1.4 a random bunny ray, cachegrind).
+    // Not in the sequential walk: there the branch is predicted and the mask
+    // lengthens the step's latency (suzanne camera rays 7-13 % slower).
     const std::uint32_t m = 0u - std::uint32_t(flip);
     near_hi = widen_up_as<kOrder>(select_bits(m, q_second, q_first), nonneg);
     far_lo = widen_dn_as<kOrder>(select_bits(m, q_first, q_second), nonneg);
@@ -205,7 +207,13 @@ inline auto sign_of(F x) {
 /// subnormal or the ray is unsafe), their sign bits, the segment clipped to
 /// the root box with widened slab crossings (NaN slabs, from a ray in a slab
 /// plane or a subnormal direction component, do not clip), and err (§3).
-template <typename F, typename M>
+///
+/// kByMask (one ray, F = float): the root box's near and far slab crossings
+/// chosen by mask instead of a branch on the direction's signs, for
+/// incoherent rays, which mispredict that branch (1.5 a random bunny ray,
+/// cachegrind). Coherent rays predict it, and there the mask cost camera
+/// rays 6 % (suzanne). The values are the same bit for bit either way.
+template <typename F, typename M, bool kByMask = false>
 inline void ray_setup_core(const F (&o)[3], const F (&dir)[3], const Box3f& root, bool certified,
                            F (&inv)[3], M (&neg)[3], F& tmin, F& tmax, F& err) {
   F mo{}, md{};
@@ -229,30 +237,22 @@ inline void ray_setup_core(const F (&o)[3], const F (&dir)[3], const Box3f& root
   // bit. NaN crossings do not clip (a comparison with NaN keeps the bound).
   const F inf = F{} + std::numeric_limits<float>::infinity();
   F enter = -inf, exit = inf;
-  if constexpr (std::is_same_v<F, float>) {
-    // One ray: the three axes in one SSE vector, each lane the scalar
-    // operations, and neg[k] ? tb : ta as a mask select. As a ?: on floats
-    // GCC branches on the direction's signs, which random rays mispredict
-    // (1.5 a ray, cachegrind, bunny). Not min/max: those differ from the
-    // select when one crossing is NaN (an origin on a slab plane, dir_k = 0).
-    using V4 = float __attribute__((vector_size(16)));
-    using M4 = std::int32_t __attribute__((vector_size(16)));
-    const V4 ov = {o[0], o[1], o[2], 0.0f}, iv = {inv[0], inv[1], inv[2], 0.0f};
-    const V4 ta = (V4{root.lo.x, root.lo.y, root.lo.z, 0.0f} - ov) * iv;
-    const V4 tb = (V4{root.hi.x, root.hi.y, root.hi.z, 0.0f} - ov) * iv;
-    const M4 m = {-std::int32_t(neg[0]), -std::int32_t(neg[1]), -std::int32_t(neg[2]), 0};
-    const V4 e = m ? tb : ta, x = m ? ta : tb;
-    for (int k = 0; k < 3; ++k) {
-      enter = e[k] > enter ? e[k] : enter;
-      exit = x[k] < exit ? x[k] : exit;
+  for (int k = 0; k < 3; ++k) {
+    const F ta = (root.lo[k] - o[k]) * inv[k], tb = (root.hi[k] - o[k]) * inv[k];
+    F e, x;
+    if constexpr (std::is_same_v<F, float> && kByMask) {
+      // neg[k] ? tb : ta by mask (a ?: on floats is a branch with GCC). Not
+      // min/max: those differ from the select when one crossing is NaN (an
+      // origin on a slab plane, dir_k = 0). Not the three axes in one SSE
+      // vector either: building it from the scalars made camera rays 7 %
+      // slower (suzanne), likely store forwarding.
+      const std::uint32_t m = 0u - std::uint32_t(neg[k]);
+      e = select_bits(m, tb, ta), x = select_bits(m, ta, tb);
+    } else {
+      e = neg[k] ? tb : ta, x = neg[k] ? ta : tb;
     }
-  } else {
-    for (int k = 0; k < 3; ++k) {
-      const F ta = (root.lo[k] - o[k]) * inv[k], tb = (root.hi[k] - o[k]) * inv[k];
-      const F e = neg[k] ? tb : ta, x = neg[k] ? ta : tb;
-      enter = e > enter ? e : enter;
-      exit = x < exit ? x : exit;
-    }
+    enter = e > enter ? e : enter;
+    exit = x < exit ? x : exit;
   }
   enter = widen_dn(enter);
   exit = widen_up(exit);
@@ -319,6 +319,8 @@ inline bool scale_if_out_of_range(const float (&o)[3], float (&dir)[3], float& t
 }
 
 /// Per-ray constants of one ray (ray_setup_core); an invalid ray is not live.
+/// kByMask: see ray_setup_core (for incoherent rays; same values).
+template <bool kByMask = false>
 inline BspRayConst bsp_ray_setup(const Ray& ray, const Box3f& root, bool certified) {
   BspRayConst c{};
   c.tmin = ray.tnear;
@@ -328,7 +330,7 @@ inline BspRayConst bsp_ray_setup(const Ray& ray, const Box3f& root, bool certifi
   if (!c.live) return c;
   for (int k = 0; k < 3; ++k) c.o[k] = ray.org[k], c.dir[k] = ray.dir[k];
   c.scaled = scale_if_out_of_range(c.o, c.dir, c.tmin, c.tmax, c.hit_scale);
-  ray_setup_core(c.o, c.dir, root, certified, c.inv, c.neg, c.tmin, c.tmax, c.err);
+  ray_setup_core<float, bool, kByMask>(c.o, c.dir, root, certified, c.inv, c.neg, c.tmin, c.tmax, c.err);
   c.live = c.tmin <= c.tmax;
   return c;
 }

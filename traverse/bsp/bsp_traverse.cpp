@@ -169,11 +169,11 @@ inline void traverse_subtree(const BspView& v, const BspRayConst& rc, const Ray&
 
 /// One ray: counts it, makes its constants, and unless it is invalid or
 /// misses the root box hands them to walk(rc, lr, hit, nearest).
-template <bool kCount, typename Walk>
+template <bool kCount, bool kIncoherent = false, typename Walk>
 inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& walk) {
   Hit hit;
   if constexpr (kCount) ++c->rays;
-  const BspRayConst rc = detail::bsp_ray_setup(ray, v.bounds, v.certified);
+  const BspRayConst rc = detail::bsp_ray_setup<kIncoherent>(ray, v.bounds, v.certified);
   if (!rc.live) return hit;
   LeafRay lr;  // made at the first leaf
   NearestHit nearest;
@@ -189,9 +189,10 @@ inline Hit trace_ray(const BspView& v, const Ray& ray, RayCounters* c, Walk&& wa
 
 /// One ray through the whole tree; kAnyHit: stop at the first leaf with a hit
 /// (occluded), whose hit is some hit in [tnear, tfar], not necessarily the nearest.
-template <bool kCount, bool kAnyHit = false>
+/// kIncoherent: the batch's rays look incoherent (bsp_ray_setup's kByMask).
+template <bool kCount, bool kAnyHit = false, bool kIncoherent = false>
 Hit trace_single(const BspView& v, const Ray& ray, RayCounters* c) {
-  return trace_ray<kCount>(v, ray, c, [&](const BspRayConst& rc, LeafRay& lr, Hit& hit,
+  return trace_ray<kCount, kIncoherent>(v, ray, c, [&](const BspRayConst& rc, LeafRay& lr, Hit& hit,
                                           NearestHit& nearest) {
     // A segment that starts at t >= 0 (camera and secondary rays) widens
     // without max and min (detail::Order); the packet kernels choose alike.
@@ -452,7 +453,7 @@ void trace_interleaved(const BspView& v, const Ray* rays, std::size_t count, Hit
   auto start = [&](Lane& L) {  // the lane's next live ray, or kIdle
     while (next < count) {
       const std::size_t i = next++;
-      L.rc = detail::bsp_ray_setup(rays[i], v.bounds, v.certified);
+      L.rc = detail::bsp_ray_setup<true>(rays[i], v.bounds, v.certified);  // incoherent rays
       if (!L.rc.live) {
         hits[i] = Hit{};
         continue;
@@ -612,6 +613,12 @@ void BspTracer::trace_batch(std::span<const Ray> rays, std::span<Hit> hits, int 
   const auto singles = [&](std::span<const Ray> r, std::span<Hit> h) {
     if (interleaves(r, counters != nullptr)) {
       trace_interleaved(v, r.data(), r.size(), h.data());
+      return;
+    }
+    // Incoherent rays in the plain walk (small trees; not counted, no top):
+    // the root clip without a branch on the direction's signs.
+    if (!counters && !has_top_ && !wide_ && !tree_.bounds.empty() && !rays_look_coherent(r)) {
+      for (std::size_t i = 0; i < r.size(); ++i) h[i] = trace_single<false, false, true>(v, r[i], nullptr);
       return;
     }
     for (std::size_t i = 0; i < r.size(); ++i) h[i] = trace(r[i], counters);

@@ -30,18 +30,9 @@ using detail::StackEntry;
 /// out that (b - o) could overflow: that slab does not clip.
 inline void clip_root(const Box3f& b, const float o[3], const float inv[3], const bool neg[3],
                       float& tmin, float& tmax) {
-  // The three axes' crossings in one SSE vector, each lane the scalar
-  // operations, and neg[k] ? t1 : t0 as a mask select: as a ?: on floats GCC
-  // branches on the direction's signs, which random rays mispredict (as in
-  // bsp_kernel.h, ray_setup_core).
-  using V4 = float __attribute__((vector_size(16)));
-  using M4 = std::int32_t __attribute__((vector_size(16)));
-  const V4 ov = {o[0], o[1], o[2], 0.0f}, iv = {inv[0], inv[1], inv[2], 0.0f};
-  const V4 t0 = (V4{b.lo.x, b.lo.y, b.lo.z, 0.0f} - ov) * iv, t1 = (V4{b.hi.x, b.hi.y, b.hi.z, 0.0f} - ov) * iv;
-  const M4 m = {-std::int32_t(neg[0]), -std::int32_t(neg[1]), -std::int32_t(neg[2]), 0};
-  const V4 tnv = m ? t1 : t0, tfv = m ? t0 : t1;
   for (int k = 0; k < 3; ++k) {
-    const float tn = tnv[k], tf = tfv[k];
+    const float t0 = (b.lo[k] - o[k]) * inv[k], t1 = (b.hi[k] - o[k]) * inv[k];
+    const float tn = neg[k] ? t1 : t0, tf = neg[k] ? t0 : t1;
     const float na = tn * kKdTLo, nb = tn * kKdTHi, fa = tf * kKdTLo, fb = tf * kKdTHi;
     const float enter = na < nb ? na : nb, exit = fa > fb ? fa : fb;
     tmin = enter > tmin ? enter : tmin;
