@@ -32,8 +32,13 @@ struct NearestHit {
   std::uint8_t on = 0;
   Vec3f p, q;
   /// The best hit's triangle (v0, v1, v2), for ties decided by the corners
-  /// alone (detail::same_t_by_corners); set with every new best hit.
-  std::array<float, 9> tri{};
+  /// alone (detail::same_t_by_corners); set with every new best hit, read
+  /// only while there is one. NaN before: no corner equals it. Not zeros:
+  /// GCC cleared the all-zero 96 bytes with `rep stos`, once for every ray of
+  /// every exact walk, and its start-up cost shows on short rays.
+  static constexpr float kNoCorner = std::numeric_limits<float>::quiet_NaN();
+  std::array<float, 9> tri{kNoCorner, kNoCorner, kNoCorner, kNoCorner, kNoCorner,
+                           kNoCorner, kNoCorner, kNoCorner, kNoCorner};
 };
 
 /// The traversal's cull bound for an exact nearest hit: the smallest float at
